@@ -1,0 +1,113 @@
+"""Command line: ``vtrials run SCENARIO --out DIR`` (and ``vtrials models``)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import textwrap
+
+from . import __version__
+from .errors import InputError, SimulationError, VtrialsError
+
+
+def _fields(cls, indent="    ") -> str:
+    from .schema import doc_table
+    lines = []
+    for name, allowed, doc in doc_table(cls):
+        lines.append(f"{indent}{name:<22} {doc} — {allowed}")
+    return "\n".join(lines)
+
+
+def _scenario_help() -> str:
+    from .maneuvers import KINDS
+    from .scenario import Environment, Head, Initial
+    from .sea import Current
+    parts = [
+        "Scenario file (TOML). Tables and fields (units at the edge: kn, deg; SI inside):",
+        "  [scenario]", _fields(Head),
+        "  [initial]   (exactly one speed field)", _fields(Initial),
+        "  [environment]", _fields(Environment),
+        "  [environment.current]   (directions: where the water flows to)", _fields(Current),
+        "  [[maneuver]]   one table per maneuver; field 'kind' selects:",
+    ]
+    for kind, cls in KINDS.items():
+        parts.append(f"    kind = \"{kind}\": {textwrap.shorten(cls.__doc__ or '', 150)}")
+        parts.append(_fields(cls, indent="      "))
+    parts += [
+        "",
+        "Outputs in DIR: truth.nc (true state history, one netCDF group per maneuver), results.json",
+        "(simulated_time_s, wall_time_s, and per maneuver name, kind and truth metrics computed",
+        "from the true track through the water), trajectory.png. Nothing is written if the",
+        "scenario has an error or the simulation fails. Exit status: 0 ok, 2 bad input, 3 the",
+        "simulation stopped (non-finite or runaway state; the message gives time and state).",
+    ]
+    return "\n".join(parts)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="vtrials",
+        description="vtrials — virtual ship trials: a MuJoCo ship in a modelled sea, run through trial "
+                    "maneuvers, with the true motion recorded and every result scored against it.",
+        epilog="Commands:\n  run      simulate a scenario file and write truth, results and plots\n"
+               "  models   list the vessel models\n\nSee 'vtrials run --help' for the scenario format.",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"vtrials {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    r = sub.add_parser("run", help="simulate a scenario and write its outputs",
+                       description="Simulate every maneuver of SCENARIO (each from the scenario's initial "
+                                   "condition, side by side in one MuJoCo batch) and write the outputs to DIR.",
+                       epilog=_scenario_help(), formatter_class=argparse.RawDescriptionHelpFormatter)
+    r.add_argument("scenario", metavar="SCENARIO", help="scenario file (TOML), e.g. scenarios/kvlcc2_l7_turning.toml")
+    r.add_argument("--out", metavar="DIR", required=True, help="output directory (created if missing)")
+    r.add_argument("--threads", type=int, default=1, metavar="N",
+                   help="MuJoCo batch threads (results are identical for any N; default 1)")
+    r.add_argument("--no-plot", action="store_true", help="skip trajectory.png")
+    r.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    sub.add_parser("models", help="list the vessel models", description="List the vessel models under models/.")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    try:
+        if args.command == "models":
+            from .vessel import available_models, load_vessel
+            for name in available_models():
+                v = load_vessel(name)
+                print(f"{name:<14} {v.meta.title}")
+            return 0
+        if args.command == "run":
+            from .run import load_scenario, simulate, write_outputs
+            if args.threads < 1:
+                raise InputError("--threads", "", "must be at least 1")
+            scn = load_scenario(args.scenario)
+            if not args.quiet:
+                print(f"vtrials: {scn.head.title} — {len(scn.maneuvers)} maneuver(s), ship {scn.vessel.name}",
+                      flush=True)
+            result = simulate(scn, nthread=args.threads)
+            doc = write_outputs(result, args.out, plot=not args.no_plot)
+            if not args.quiet:
+                print(f"simulated {doc['simulated_time_s']:.1f} s in {doc['wall_time_s']:.2f} s wall time")
+                for m in doc["maneuvers"]:
+                    keys = [k for k in m["truth"] if k != "ship_length_m"][:4]
+                    summary = ", ".join(f"{k} {m['truth'][k]:.4g}" for k in keys
+                                        if isinstance(m["truth"][k], (int, float)))
+                    print(f"  {m['name']:<24} {m['kind']:<15} {summary}")
+                print(f"wrote {args.out}/results.json, truth.nc" + ("" if args.no_plot else ", trajectory.png"))
+            return 0
+    except SimulationError as exc:
+        print(f"vtrials: simulation stopped: {exc}", file=sys.stderr)
+        return 3
+    except VtrialsError as exc:
+        print(f"vtrials: error: {exc}", file=sys.stderr)
+        return 2
+    return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

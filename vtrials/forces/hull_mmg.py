@@ -1,0 +1,83 @@
+"""Hull maneuvering forces of the MMG standard method.
+
+Yasukawa H. & Yoshimura Y. (2015) "Introduction of MMG standard method for ship maneuvering
+predictions", J. Mar. Sci. Technol. 20:37–52, eqs. (7)–(9). Forces act at midship; the velocity
+used is the velocity relative to the water. The hull lateral force and surge force are taken to
+act at depth ``z_H`` below the waterline, which gives the heel moment in a turn (an assumption of
+this project: MMG is a horizontal-plane model and names no vertical centre).
+
+Validity: ahead motion (u > 0). Near U = 0 the non-dimensional rates blow up; ``U`` is floored
+at ``u_floor`` so the kernel stays finite, but low-speed maneuvers need a low-speed hull model.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numba as nb
+import numpy as np
+
+from ..schema import num
+from . import layout as L
+
+KIND = 1
+
+
+@dataclasses.dataclass(frozen=True)
+class HullMMG:
+    """Non-dimensional hull derivatives (prime system: forces ½ρLdU², moments ½ρL²dU²)."""
+
+    R0: float = num("resistance coefficient R'_0", "", 0.0, 1.0)
+    X_vv: float = num("X'_vv", "", -5, 5)
+    X_vr: float = num("X'_vr", "", -5, 5)
+    X_rr: float = num("X'_rr", "", -5, 5)
+    X_vvvv: float = num("X'_vvvv", "", -10, 10)
+    Y_v: float = num("Y'_v", "", -5, 5)
+    Y_r: float = num("Y'_r", "", -5, 5)
+    Y_vvv: float = num("Y'_vvv", "", -10, 10)
+    Y_vvr: float = num("Y'_vvr", "", -10, 10)
+    Y_vrr: float = num("Y'_vrr", "", -10, 10)
+    Y_rrr: float = num("Y'_rrr", "", -10, 10)
+    N_v: float = num("N'_v", "", -5, 5)
+    N_r: float = num("N'_r", "", -5, 5)
+    N_vvv: float = num("N'_vvv", "", -10, 10)
+    N_vvr: float = num("N'_vvr", "", -10, 10)
+    N_vrr: float = num("N'_vrr", "", -10, 10)
+    N_rrr: float = num("N'_rrr", "", -10, 10)
+    z_H: float = num("depth of the centre of hull surge and sway forces below the waterline", "m", -100, 100)
+
+
+def pack(h: HullMMG, length: float, draught: float, rho: float, u_floor: float) -> np.ndarray:
+    """Parameter block of the kernel."""
+    return np.array([length, draught, rho, u_floor, h.R0, h.X_vv, h.X_vr, h.X_rr, h.X_vvvv,
+                     h.Y_v, h.Y_r, h.Y_vvv, h.Y_vvr, h.Y_vrr, h.Y_rrr,
+                     h.N_v, h.N_r, h.N_vvv, h.N_vvr, h.N_vrr, h.N_rrr, h.z_H], dtype=np.float64)
+
+
+@nb.njit(cache=True, fastmath=False)
+def kernel(p, env, ctx, aux, w):
+    Lpp = p[0]
+    d = p[1]
+    rho = p[2]
+    u = ctx[L.NU_R + 0]
+    v = ctx[L.NU_R + 1]
+    r = ctx[L.NU_R + 5]
+    U = math.sqrt(u * u + v * v)
+    if U < p[3]:
+        U = p[3]
+    vp = v / U
+    rp = r * Lpp / U
+    q = 0.5 * rho * Lpp * d * U * U
+    X = q * (-p[4] + p[5] * vp * vp + p[6] * vp * rp + p[7] * rp * rp + p[8] * vp ** 4)
+    Y = q * (p[9] * vp + p[10] * rp + p[11] * vp ** 3 + p[12] * vp * vp * rp
+             + p[13] * vp * rp * rp + p[14] * rp ** 3)
+    N = q * Lpp * (p[15] * vp + p[16] * rp + p[17] * vp ** 3 + p[18] * vp * vp * rp
+                   + p[19] * vp * rp * rp + p[20] * rp ** 3)
+    zH = p[21]
+    w[0] = X
+    w[1] = Y
+    w[2] = 0.0
+    w[3] = -zH * Y
+    w[4] = zH * X
+    w[5] = N

@@ -1,0 +1,115 @@
+"""Rudder forces of the MMG standard method, behind a propeller.
+
+Yasukawa & Yoshimura (2015) eqs. (18)–(26):
+u_R = ε u (1 − w_P) √(η{1 + κ[√(1 + 8K_T/(πJ²)) − 1]}² + (1 − η)), η = D_P/H_R, written here
+as ε √(η(u_P + κ(√(u_P² + 8K_T n²D_P²/π) − u_P))² + (1 − η)u_P²) with u_P = u(1 − w_P), which is
+the same for n > 0 and stays finite as J → 0; v_R = U γ_R β_R, β_R = β − l′_R r′;
+α_R = δ − atan(v_R/u_R); F_N = ½ρA_R(u_R² + v_R²) f_α sin α_R;
+X_R = −(1 − t_R)F_N sin δ, Y_R = −(1 + a_H)F_N cos δ, N_R = −(x_R + a_H x_H)F_N cos δ.
+Sign: δ > 0 (trailing edge to starboard) gives N_R > 0, a turn to starboard.
+The rudder's own lateral force acts at the rudder's centre depth z_R, the hull force it induces
+(a_H part) at the hull's force depth z_H — the heel moment in a turn follows from these.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numba as nb
+import numpy as np
+
+from ..schema import num, text
+from . import layout as L
+
+KIND = 3
+
+
+@dataclasses.dataclass(frozen=True)
+class RudderMMG:
+    name: str = text("rudder name")
+    joint: str = text("MJCF hinge joint of this rudder (axis 0 0 -1: positive = trailing edge to starboard)")
+    propeller: str = text("name of the propeller in front of this rudder")
+    area: float = num("rudder area A_R", "m^2", 0.0, 500.0, lo_open=True)
+    span: float = num("rudder span H_R", "m", 0.0, 50.0, lo_open=True)
+    x: float = num("longitudinal position x_R from midship (MMG: −0.5 L)", "m", -300, 300)
+    y: float = num("lateral position (+ starboard)", "m", -50, 50)
+    z: float = num("depth of the rudder's centre of pressure below the waterline", "m", -10, 50)
+    t_R: float = num("steering resistance deduction factor t_R", "", 0.0, 1.0)
+    a_H: float = num("rudder force increase factor a_H", "", 0.0, 2.0)
+    x_H_prime: float = num("position of the additional lateral force x'_H (÷L)", "", -1, 1)
+    gamma_R_neg: float = num("flow straightening coefficient γ_R for β_R < 0", "", 0.0, 2.0)
+    gamma_R_pos: float = num("flow straightening coefficient γ_R for β_R > 0", "", 0.0, 2.0)
+    l_R_prime: float = num("effective longitudinal coordinate l'_R (÷L)", "", -2, 2)
+    epsilon: float = num("ratio of wake fractions at rudder and propeller ε", "", 0.0, 3.0)
+    kappa: float = num("propeller-to-rudder flow acceleration factor κ", "", 0.0, 2.0)
+    f_alpha: float = num("rudder lift gradient coefficient f_α", "1/rad", 0.0, 10.0)
+    max_angle_deg: float = num("maximum rudder angle", "deg", 0.0, 90.0, lo_open=True)
+    rate_deg_s: float = num("steering gear maximum rate", "deg/s", 0.0, 100.0, lo_open=True)
+    time_constant: float = num("steering gear follow-up time constant (proportional band = rate × T)",
+                               "s", 0.0, 30.0, lo_open=True)
+
+
+def pack(rd: RudderMMG, index: int, prop_index: int, prop_diameter: float, length: float,
+         rho: float, u_floor: float, z_hull: float) -> np.ndarray:
+    return np.array([index, prop_index, length, rho, u_floor, rd.area, rd.span, rd.x, rd.y, rd.z,
+                     rd.t_R, rd.a_H, rd.x_H_prime, rd.gamma_R_neg, rd.gamma_R_pos, rd.l_R_prime,
+                     rd.epsilon, rd.kappa, rd.f_alpha, prop_diameter, z_hull], dtype=np.float64)
+
+
+@nb.njit(cache=True, fastmath=False)
+def kernel(p, env, ctx, aux, w):
+    k = int(p[0])
+    kp = int(p[1])
+    Lpp = p[2]
+    rho = p[3]
+    AR = p[5]
+    HR = p[6]
+    xR = p[7]
+    yR = p[8]
+    zR = p[9]
+    D = p[19]
+    u = ctx[L.NU_R + 0]
+    v = ctx[L.NU_R + 1]
+    r = ctx[L.NU_R + 5]
+    U = math.sqrt(u * u + v * v)
+    if U < p[4]:
+        U = p[4]
+    beta = math.atan2(-v, u)
+    rp = r * Lpp / U
+    delta = ctx[L.DELTA + k]
+    b = L.AUX_PROP + 8 * kp
+    KT = aux[b + L.P_KT]
+    n = aux[b + L.P_N]
+    uP = aux[b + L.P_UA]
+    eta = D / HR
+    jet = uP * uP + 8.0 * KT * n * n * D * D / math.pi
+    if jet < 0.0:
+        jet = 0.0
+    slip = uP + p[17] * (math.sqrt(jet) - uP)
+    uR = p[16] * math.sqrt(eta * slip * slip + (1.0 - eta) * uP * uP)
+    beta_R = beta - p[15] * rp
+    gamma = p[13] if beta_R < 0.0 else p[14]
+    vR = U * gamma * beta_R
+    alpha = delta - math.atan2(vR, uR)
+    UR2 = uR * uR + vR * vR
+    FN = 0.5 * rho * AR * UR2 * p[18] * math.sin(alpha)
+    aH = p[11]
+    xH = p[12] * Lpp
+    cd = math.cos(delta)
+    XR = -(1.0 - p[10]) * FN * math.sin(delta)
+    YR = -(1.0 + aH) * FN * cd
+    NR = -(xR + aH * xH) * FN * cd
+    z_hull = p[20]
+    w[0] = XR
+    w[1] = YR
+    w[2] = 0.0
+    w[3] = (zR + aH * z_hull) * FN * cd
+    w[4] = zR * XR
+    w[5] = NR - yR * XR
+    br = L.AUX_RUD + 8 * k
+    aux[br + L.R_FN] = FN
+    aux[br + L.R_UR] = uR
+    aux[br + L.R_VR] = vR
+    aux[br + L.R_ALPHA] = alpha
+    aux[br + L.R_UR2] = UR2

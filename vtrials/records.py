@@ -1,0 +1,93 @@
+"""Writing and reading the project's data files (CF-style netCDF4 through h5netcdf).
+
+One writer for every file vtrials produces: groups of variables sharing a time dimension, each
+with units and long names, written to a temporary file and renamed into place only when it is
+complete, so a failed or killed run leaves no partial file. Output is byte-reproducible (no
+timestamps are stored).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+import h5netcdf
+import numpy as np
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path):
+    """Yield a temporary path next to ``path``; on success it replaces ``path`` atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def _attr(v):
+    if isinstance(v, bool):
+        return np.int8(v)
+    if v is None:
+        return ""
+    return v
+
+
+def write_groups(path: str | Path, groups: dict, attrs: dict) -> None:
+    """Write ``groups`` = {name: {"time": array, "variables": {var: (array, units, long_name)},
+    "attrs": {...}}} as netCDF4 groups with a ``time`` dimension each; ``attrs`` are global."""
+    with atomic_path(path) as tmp:
+        with h5netcdf.File(tmp, "w", track_order=True) as f:
+            for k, v in attrs.items():
+                f.attrs[k] = _attr(v)
+            for gname, g in groups.items():
+                grp = f.create_group(gname)
+                t = np.asarray(g["time"], dtype=np.float64)
+                grp.dimensions["time"] = t.size
+                tv = grp.create_variable("time", ("time",), np.float64, compression="gzip",
+                                         compression_opts=4, shuffle=True)
+                tv[:] = t
+                tv.attrs["units"] = "s"
+                tv.attrs["long_name"] = "simulated time"
+                tv.attrs["standard_name"] = "time"
+                for k, v in g.get("attrs", {}).items():
+                    grp.attrs[k] = _attr(v)
+                for vname, (arr, units, long_name) in g["variables"].items():
+                    arr = np.asarray(arr, dtype=np.float64)
+                    var = grp.create_variable(vname, ("time",), np.float64, compression="gzip",
+                                              compression_opts=4, shuffle=True)
+                    var[:] = arr
+                    var.attrs["units"] = units
+                    var.attrs["long_name"] = long_name
+
+
+def read_groups(path: str | Path) -> dict:
+    """Read a file written by :func:`write_groups` back into plain numpy arrays and dicts."""
+    out = {"attrs": {}, "groups": {}}
+    with h5netcdf.File(path, "r") as f:
+        out["attrs"] = {k: _plain(v) for k, v in f.attrs.items()}
+        for gname, grp in f.groups.items():
+            g = {"attrs": {k: _plain(v) for k, v in grp.attrs.items()}, "variables": {}, "units": {}}
+            for vname, var in grp.variables.items():
+                g["variables"][vname] = np.asarray(var[:])
+                g["units"][vname] = _plain(var.attrs.get("units", ""))
+            out["groups"][gname] = g
+    return out
+
+
+def _plain(v):
+    if isinstance(v, np.ndarray) and v.ndim == 0:
+        return v.item()
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, bytes):
+        return v.decode()
+    return v

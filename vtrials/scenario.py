@@ -1,0 +1,138 @@
+"""Scenario files: which ship, where and in what condition it starts, the sea, and the maneuvers.
+
+A scenario is TOML with these tables (see ``scenarios/`` for examples, ``vtrials run --help`` for
+every field):
+
+``[scenario]``      title, ship (a folder under models/), seed, timestep_s, planar, record_every
+``[initial]``       exactly one of froude_number / speed_kn / speed_mps; heading_deg; propulsion
+``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.sea.Current`)
+``[[maneuver]]``    one table per maneuver, with ``kind`` and that kind's fields
+                    (:mod:`vtrials.maneuvers`)
+
+Everything is checked before anything runs or is written; every error names the file and the
+field.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+from .errors import InputError
+from .maneuvers import KINDS
+from .schema import flag, integer, load_toml, num, read_table, text, unknown_key
+from .sea import Current
+from .units import DEG, KNOT, froude_to_speed
+from .vessel import Vessel, load_vessel
+
+
+@dataclasses.dataclass(frozen=True)
+class Head:
+    title: str = text("one-line description of the scenario")
+    ship: str = text("vessel model: a folder under models/ (e.g. kvlcc2_l7)")
+    seed: int = integer("seed of every random draw in the run (records are reproducible from it)", 0, 2 ** 63 - 1)
+    timestep_s: float = num("simulation time step", "s", 0.0, 1.0, lo_open=True)
+    planar: bool = flag("hold heave, roll and pitch at zero (3-DOF validation mode)", default=False)
+    record_every: int = integer("write the truth state every this many steps", 1, 100000, default=1)
+
+
+@dataclasses.dataclass(frozen=True)
+class Initial:
+    froude_number: float = num("approach speed as a length Froude number", "", 0.0, 1.0, lo_open=True, default=None)
+    speed_kn: float = num("approach speed through the water", "kn", 0.0, 60.0, lo_open=True, default=None)
+    speed_mps: float = num("approach speed through the water", "m/s", 0.0, 30.0, lo_open=True, default=None)
+    heading_deg: float = num("approach heading (from north, clockwise)", "deg", -360.0, 360.0, default=0.0)
+    propulsion: str = text("how the shafts are set: the r/min that holds the speed in calm water",
+                           ("self_propelled",), default="self_propelled")
+
+
+@dataclasses.dataclass(frozen=True)
+class Environment:
+    water_depth_m: float = num("water depth (the hull models are deep-water models)", "m", 0.0, 12000.0,
+                               lo_open=True, default=10000.0)
+
+
+@dataclasses.dataclass
+class Scenario:
+    path: Path
+    head: Head
+    initial: Initial
+    environment: Environment
+    current: Current
+    maneuvers: list
+    vessel: Vessel
+
+    @property
+    def speed(self) -> float:
+        """Approach speed through the water [m/s]."""
+        i = self.initial
+        if i.froude_number is not None:
+            return froude_to_speed(i.froude_number, self.vessel.length)
+        if i.speed_kn is not None:
+            return i.speed_kn * KNOT
+        return i.speed_mps
+
+    @property
+    def heading(self) -> float:
+        return self.initial.heading_deg * DEG
+
+
+_TOP = ("scenario", "initial", "environment", "maneuver")
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and check a scenario file (and the vessel it names)."""
+    p = Path(path)
+    f = str(path)
+    doc = load_toml(p)
+    for key in doc:
+        if key not in _TOP:
+            raise unknown_key(f, "", key, list(_TOP))
+    if "scenario" not in doc:
+        raise InputError(f, "scenario", "missing table [scenario]")
+    head, _ = read_table(Head, doc["scenario"], f, "scenario")
+    vessel = load_vessel(head.ship, file_for_errors=f, field_for_errors="scenario.ship")
+    init, _ = read_table(Initial, doc.get("initial", {}), f, "initial")
+    given = [k for k in ("froude_number", "speed_kn", "speed_mps") if getattr(init, k) is not None]
+    if len(given) != 1:
+        raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps"
+                         + (f" (got {', '.join(given)})" if given else ""))
+    env_tab = dict(doc.get("environment", {}))
+    cur_tab = env_tab.pop("current", {})
+    env, _ = read_table(Environment, env_tab, f, "environment")
+    if env.water_depth_m <= vessel.particulars.draught:
+        raise InputError(f, "environment.water_depth_m", f"{env.water_depth_m} m does not float the ship "
+                                                         f"(draught {vessel.particulars.draught} m)")
+    current, _ = read_table(Current, cur_tab, f, "environment.current")
+    items = doc.get("maneuver")
+    if not isinstance(items, list) or not items:
+        raise InputError(f, "maneuver", "expected at least one [[maneuver]] table")
+    maneuvers = []
+    names = set()
+    max_rudder = math.degrees(vessel.max_rudder)
+    for i, tab in enumerate(items):
+        sec = f"maneuver[{i}]"
+        if not isinstance(tab, dict):
+            raise InputError(f, sec, "expected a table")
+        kind = tab.get("kind")
+        if kind not in KINDS:
+            raise InputError(f, f"{sec}.kind", f"unknown maneuver kind {kind!r} (allowed: {', '.join(KINDS)})")
+        m, _ = read_table(KINDS[kind], tab, f, sec, extra_keys=("kind",))
+        if m.name in names:
+            raise InputError(f, f"{sec}.name", f"duplicate maneuver name {m.name!r}")
+        names.add(m.name)
+        for field, value in m.rudders():
+            if abs(value) > max_rudder + 1e-9:
+                raise InputError(f, f"{sec}.{field}", f"{value:g}° is beyond the maximum rudder angle of "
+                                                      f"{vessel.name} ({max_rudder:g}°)")
+        maneuvers.append(m)
+    scn = Scenario(p, head, init, env, current, maneuvers, vessel)
+    if scn.speed > 0.9 * _runaway_speed(vessel):
+        raise InputError(f, "initial", f"approach speed {scn.speed:.2f} m/s is beyond this hull model's range")
+    return scn
+
+
+def _runaway_speed(vessel: Vessel) -> float:
+    from .units import G
+    return 2.0 * math.sqrt(G * vessel.length)

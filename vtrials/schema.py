@@ -1,0 +1,216 @@
+"""Checked reading of TOML tables into typed dataclasses.
+
+Model, scenario and agenda files are read through this one module so that every bad input gets
+the same kind of message: file, dotted field name, what was wrong, what is allowed. Declare a
+parameter with :func:`num`, :func:`text`, :func:`flag` or :func:`integer` as a dataclass field;
+:func:`read_table` then checks a TOML table against the dataclass:
+
+* unknown keys are errors (with the closest known name suggested),
+* missing keys without a default are errors,
+* values must have the declared type and lie in the declared range,
+* in *sourced* tables (ship model files) every number must name its source, either inline
+  (``Y_v = { value = -0.315, source = "..." }``) or through a ``source`` key of the table that
+  applies to its bare numbers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError
+
+_SPEC = "vtrials_spec"
+
+
+@dataclasses.dataclass(frozen=True)
+class Spec:
+    """What a field accepts."""
+
+    kind: str  # "num", "int", "text", "flag"
+    doc: str = ""
+    unit: str = ""
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    choices: tuple[str, ...] = ()
+    required: bool = True
+
+    def allowed(self) -> str:
+        if self.kind == "text":
+            return "one of " + ", ".join(repr(c) for c in self.choices) if self.choices else "a string"
+        if self.kind == "flag":
+            return "true or false"
+        what = "an integer" if self.kind == "int" else "a number"
+        lo = "-inf" if self.lo is None else f"{self.lo:g}"
+        hi = "inf" if self.hi is None else f"{self.hi:g}"
+        if self.lo is None and self.hi is None:
+            rng = ""
+        else:
+            rng = f" in {'(' if self.lo_open or self.lo is None else '['}{lo}, {hi}{')' if self.hi_open or self.hi is None else ']'}"
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{what}{rng}{unit}"
+
+
+def _field(spec: Spec, default: Any) -> Any:
+    md = {_SPEC: spec}
+    if default is dataclasses.MISSING:
+        return dataclasses.field(metadata=md)
+    return dataclasses.field(default=default, metadata=md)
+
+
+def num(doc: str = "", unit: str = "", lo: float | None = None, hi: float | None = None, *,
+        lo_open: bool = False, hi_open: bool = False, default: Any = dataclasses.MISSING) -> Any:
+    """A real-valued field in [lo, hi] (open ends with lo_open/hi_open)."""
+    return _field(Spec("num", doc, unit, lo, hi, lo_open, hi_open, required=default is dataclasses.MISSING), default)
+
+
+def integer(doc: str = "", lo: int | None = None, hi: int | None = None, *, default: Any = dataclasses.MISSING) -> Any:
+    """An integer field in [lo, hi]."""
+    return _field(Spec("int", doc, "", lo, hi, required=default is dataclasses.MISSING), default)
+
+
+def text(doc: str = "", choices: tuple[str, ...] = (), *, default: Any = dataclasses.MISSING) -> Any:
+    """A string field, optionally restricted to choices."""
+    return _field(Spec("text", doc, choices=tuple(choices), required=default is dataclasses.MISSING), default)
+
+
+def flag(doc: str = "", *, default: Any = dataclasses.MISSING) -> Any:
+    """A boolean field."""
+    return _field(Spec("flag", doc, required=default is dataclasses.MISSING), default)
+
+
+def spec_of(f: dataclasses.Field) -> Spec | None:
+    return f.metadata.get(_SPEC)
+
+
+def load_toml(path: str | Path) -> dict:
+    """Parse a TOML file; a missing or malformed file is an :class:`InputError` naming it."""
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise InputError(str(path), "", "file not found") from None
+    except OSError as exc:
+        raise InputError(str(path), "", f"cannot read file ({exc.strerror})") from None
+    try:
+        return tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise InputError(str(path), "", "not UTF-8 text; a TOML file is expected") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(str(path), "", f"malformed TOML: {exc}") from None
+
+
+def unknown_key(file: str, section: str, key: str, known: list[str]) -> InputError:
+    """The error for a key that a table does not have, with the closest known names."""
+    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    allowed = ", ".join(sorted(known)) if len(known) <= 40 else f"{len(known)} known names"
+    return InputError(file, _join(section, key), f"unknown field{hint} (allowed: {allowed})")
+
+
+def _join(section: str, key: str) -> str:
+    return f"{section}.{key}" if section else key
+
+
+def check_value(spec: Spec, value: Any, file: str, name: str) -> Any:
+    """Check one value against its spec; return it converted (int→float for numbers)."""
+    if spec.kind in ("num", "int"):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
+        if spec.kind == "int":
+            if isinstance(value, float):
+                if not value.is_integer():
+                    raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
+                value = int(value)
+        else:
+            value = float(value)
+            if not math.isfinite(value):
+                raise InputError(file, name, f"expected a finite number ({spec.allowed()}), got {value!r}")
+        lo_bad = spec.lo is not None and (value < spec.lo or (spec.lo_open and value == spec.lo))
+        hi_bad = spec.hi is not None and (value > spec.hi or (spec.hi_open and value == spec.hi))
+        if lo_bad or hi_bad:
+            raise InputError(file, name, f"{value!r} is out of range: expected {spec.allowed()}")
+        return value
+    if spec.kind == "text":
+        if not isinstance(value, str):
+            raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
+        if spec.choices and value not in spec.choices:
+            raise InputError(file, name, f"{value!r} is not allowed: expected {spec.allowed()}")
+        return value
+    if spec.kind == "flag":
+        if not isinstance(value, bool):
+            raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
+        return value
+    raise AssertionError(spec.kind)
+
+
+def read_table(cls: type, table: Any, file: str, section: str, *, sourced: bool = False,
+               extra_keys: tuple[str, ...] = ()) -> tuple[Any, dict[str, str]]:
+    """Read a TOML table into dataclass ``cls``.
+
+    Returns the instance and, for sourced tables, a dict field → source text. Keys in
+    ``extra_keys`` are tolerated (the caller reads them).
+    """
+    if not isinstance(table, dict):
+        raise InputError(file, section, f"expected a table, got {type(table).__name__} {table!r}")
+    fields = {f.name: f for f in dataclasses.fields(cls) if spec_of(f) is not None}
+    values: dict[str, Any] = {}
+    sources: dict[str, str] = {}
+    default_source = None
+    if sourced:
+        default_source = table.get("source")
+        if default_source is not None and not (isinstance(default_source, str) and default_source.strip()):
+            raise InputError(file, _join(section, "source"), "expected a non-empty string naming the source")
+    for key, raw in table.items():
+        if sourced and key == "source":
+            continue
+        if key in extra_keys:
+            continue
+        if key not in fields:
+            raise unknown_key(file, section, key, list(fields) + list(extra_keys))
+        name = _join(section, key)
+        spec = spec_of(fields[key])
+        value = raw
+        if sourced and spec.kind in ("num", "int"):
+            if isinstance(raw, dict):
+                bad = set(raw) - {"value", "source", "unit", "note"}
+                if bad:
+                    raise InputError(file, name, f"unknown keys {sorted(bad)} (allowed: value, source, unit, note)")
+                if "value" not in raw:
+                    raise InputError(file, name, "inline table without 'value'")
+                src = raw.get("source", default_source)
+                if not (isinstance(src, str) and src.strip()):
+                    raise InputError(file, name, "no source given: add source = \"...\" (inline or for the table)")
+                unit = raw.get("unit")
+                if unit is not None and spec.unit and unit != spec.unit:
+                    raise InputError(file, name, f"unit {unit!r} given, but this field is in {spec.unit!r} (SI)")
+                value = raw["value"]
+                sources[key] = src.strip()
+            else:
+                if default_source is None:
+                    raise InputError(file, name, "no source given: write { value = ..., source = \"...\" } "
+                                                 "or give the table a source")
+                sources[key] = default_source.strip()
+        values[key] = check_value(spec, value, file, name)
+    for key, f in fields.items():
+        if key in values:
+            continue
+        if spec_of(f).required:
+            raise InputError(file, _join(section, key), f"missing (expected {spec_of(f).allowed()})")
+    return cls(**values), sources
+
+
+def doc_table(cls: type) -> list[tuple[str, str, str]]:
+    """(name, allowed, doc) for every declared field of cls — used by --help texts and docs."""
+    rows = []
+    for f in dataclasses.fields(cls):
+        s = spec_of(f)
+        if s is not None:
+            rows.append((f.name, s.allowed(), s.doc))
+    return rows

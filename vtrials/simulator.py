@@ -1,0 +1,318 @@
+"""The simulator: N ships of one vessel type stepped together in MuJoCo.
+
+One code path for everything — the CLI, the Python API, campaigns and gymnasium environments:
+``mujoco.batch.Batch`` holds the N MuJoCo states (N = 1 included); :func:`vtrials.dynamics.
+step_forces` computes every ship's generalized forces in one numba call per step; MuJoCo
+integrates (semi-implicit Euler). Per-ship differences (environment, later loading condition)
+live in per-ship parameter rows, so ships never share mutable state and results do not depend
+on how many ships run together or on the thread count.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+
+import mujoco
+import numpy as np
+from mujoco import batch as mjbatch
+from scipy.optimize import brentq
+
+from . import dynamics as DY
+from . import helm as H
+from .errors import SimulationError
+from .forces import layout as L
+from .propulsion import S_DADR, S_PROP
+from .sea import NENV, Current
+from .sea import pack as pack_env
+from .units import G, deg
+from .vessel import Vessel
+
+
+@dataclasses.dataclass
+class ShipState:
+    """A ship's initial condition (SI; velocities through the water, body axes)."""
+
+    x: float = 0.0
+    y: float = 0.0
+    heading: float = 0.0
+    u: float = 0.0
+    v: float = 0.0
+    r: float = 0.0
+    z: float = 0.0
+    roll: float = 0.0
+    pitch: float = 0.0
+    shaft_rps: tuple = ()
+    rudder: float = 0.0
+    time: float = 0.0
+
+
+def euler_to_quat(phi: float, theta: float, psi: float) -> np.ndarray:
+    """z-y-x Euler angles → MuJoCo quaternion (w, x, y, z), body→world."""
+    cphi, sphi = math.cos(phi / 2), math.sin(phi / 2)
+    cth, sth = math.cos(theta / 2), math.sin(theta / 2)
+    cpsi, spsi = math.cos(psi / 2), math.sin(psi / 2)
+    return np.array([cpsi * cth * cphi + spsi * sth * sphi,
+                     cpsi * cth * sphi - spsi * sth * cphi,
+                     cpsi * sth * cphi + spsi * cth * sphi,
+                     spsi * cth * cphi - cpsi * sth * sphi])
+
+
+class Simulator:
+    """N ships of one :class:`Vessel`, each with its own environment block.
+
+    Parameters
+    ----------
+    vessel: the loaded vessel model.
+    n_ships: number of independent ships.
+    dt: time step [s].
+    envs: per-ship environment blocks (``sea.pack``), or one for all; calm deep water if None.
+    nthread: MuJoCo batch threads (results are identical for any value).
+    record_every: write a truth row every this many steps (0: no truth recording).
+    planar: hold heave, roll and pitch at zero (a 3-DOF validation mode).
+    """
+
+    def __init__(self, vessel: Vessel, n_ships: int = 1, dt: float = 0.01, envs=None, nthread: int = 1,
+                 record_every: int = 1, limits: tuple[float, float, float] | None = None,
+                 planar: bool = False):
+        self.vessel = vessel
+        self.n = int(n_ships)
+        self.dt = float(dt)
+        model = copy.copy(vessel.model)
+        model.opt.timestep = self.dt
+        self.model = model
+        self.batch = mjbatch.Batch(model, self.n, nthread=nthread)
+        self.qpos = self.batch.bind("qpos")
+        self.qvel = self.batch.bind("qvel")
+        self.qfrc = self.batch.bind("qfrc_applied")
+        self.time = self.batch.bind("time")
+        comps = vessel.components
+        self.comp_names = [c.name for c in comps]
+        self.comp_kind = np.array([c.kind for c in comps], dtype=np.int64)
+        offs = np.cumsum([0] + [len(c.params) for c in comps])
+        self.comp_off = offs.astype(np.int64)
+        self.comp_par = np.tile(np.concatenate([c.params for c in comps]), (self.n, 1))
+        Mtot = vessel.M_RB + vessel.M_A
+        self.planar = bool(planar)
+        if self.planar:
+            # validation mode: heave, roll and pitch held at zero (3-DOF horizontal-plane motion)
+            keep = [0, 1, 5]
+            Minv = np.zeros((6, 6))
+            Minv[np.ix_(keep, keep)] = np.linalg.inv(Mtot[np.ix_(keep, keep)])
+        else:
+            Minv = np.linalg.inv(Mtot)
+        self.minv = np.tile(Minv, (self.n, 1, 1))
+        self.mrb = np.tile(vessel.M_RB, (self.n, 1, 1))
+        self.ma = np.tile(vessel.M_A, (self.n, 1, 1))
+        self.munk_in_hull = 1 if vessel.added_mass.munk_in_hull else 0
+        self.rb = np.tile(np.array([vessel.mass, *vessel.r_G]), (self.n, 1))
+        self.steer = np.ascontiguousarray(vessel.steering)
+        self.shaftp = np.ascontiguousarray(vessel.shaft_params)
+        self.nr = self.steer.shape[0]
+        self.ns = self.shaftp.shape[0]
+        if envs is None:
+            envs = pack_env(Current(), 1e4)
+        envs = np.asarray(envs, dtype=np.float64)
+        self.env = np.ascontiguousarray(np.broadcast_to(envs, (self.n, NENV))).copy()
+        self.rud_cmd = np.zeros((self.n, self.nr))
+        self.shaft_cmd = np.zeros((self.n, self.ns))
+        self.gov = np.zeros((self.n, self.ns))
+        self.nav = np.zeros((self.n, DY.NNAV))
+        self.phases, self.hs, self.events, self.ecount = H.new_arrays(self.n)
+        self.ctx = np.zeros((self.n, L.NCTX))
+        self.aux = np.zeros((self.n, L.NAUX))
+        self.comp_w = np.zeros((self.n, len(comps) + 1, 6))
+        self.nudot = np.zeros((self.n, 6))
+        self.status = np.zeros(self.n, dtype=np.int64)
+        Lpp = vessel.length
+        if limits is None:
+            # runaway limits: Fn 2 through the water, 70° heel or trim, 3 rad/s
+            limits = (2.0 * math.sqrt(G * Lpp), math.radians(70.0), 3.0)
+        self.limits = np.array(limits, dtype=np.float64)
+        self.record_every = int(record_every)
+        self.rec_width = DY.record_width(self.nr, self.ns, len(comps))
+        self.rec_names = DY.record_names(self.nr, self.ns, self.comp_names)
+        self._chunks: list[np.ndarray] = []
+        self._chunk = None
+        self._krow = 0
+        self._step_count = 0
+        self._no_rec = np.zeros((1, self.n, self.rec_width))
+
+    # ------------------------------------------------------------------ state
+    def set_state(self, ship: int, s: ShipState) -> None:
+        """Place ship ``ship`` in condition ``s`` (velocity through the water + current)."""
+        q = self.qpos[ship]
+        v = self.qvel[ship]
+        q[:] = 0.0
+        v[:] = 0.0
+        q[0:3] = (s.x, s.y, s.z)
+        quat = euler_to_quat(s.roll, s.pitch, s.heading)
+        q[3:7] = quat
+        R = np.zeros(9)
+        DY.quat_to_mat(*quat, R)
+        R = R.reshape(3, 3)
+        vc = self._current_world(ship, s.x, s.y, s.time)
+        v[0:3] = R @ np.array([s.u, s.v, 0.0]) + vc
+        v[5] = s.r
+        for k in range(self.nr):
+            q[int(self.steer[k, 3])] = s.rudder
+            self.rud_cmd[ship, k] = s.rudder
+        rps = tuple(s.shaft_rps) + (0.0,) * (self.ns - len(s.shaft_rps))
+        for k in range(self.ns):
+            v[int(self.shaftp[k, S_DADR])] = 2.0 * math.pi * rps[k]
+            self.shaft_cmd[ship, k] = rps[k]
+        self.time[ship] = s.time
+        self.nav[ship] = 0.0
+        self.nav[ship, DY.NV_PSI_U] = s.heading
+        self.hs[ship] = 0.0
+        self.ecount[ship] = 0
+        self.qfrc[ship] = 0.0
+        # governor integrators hold the propeller torque of this state (no start-up transient)
+        self.evaluate()
+        for k in range(self.ns):
+            kp = int(self.shaftp[k, S_PROP])
+            nk = self.ctx[ship, L.SHAFT_N + kp]
+            self.gov[ship, k] = self.aux[ship, L.AUX_PROP + 8 * kp + L.P_TORQUE] + self.shaftp[k, 1] * nk
+
+    def _current_world(self, ship: int, x: float, y: float, t: float) -> np.ndarray:
+        from .sea import current_at
+        vn, ve, _, _ = current_at(self.env[ship], x, y, t)
+        return np.array([vn, ve, 0.0])
+
+    def evaluate(self) -> np.ndarray:
+        """Forces and accelerations at the current states, without side effects on the simulation.
+
+        Fills ``ctx``, ``aux``, ``comp_w``, ``nudot`` and ``qfrc`` as a step would; returns ν̇ (N, 6).
+        """
+        nav = self.nav.copy()
+        gov = self.gov.copy()
+        hs = self.hs.copy()
+        ev = self.events.copy()
+        ec = self.ecount.copy()
+        rc = self.rud_cmd.copy()
+        self._call(nav=nav, gov=gov, hs=hs, events=ev, ecount=ec, rud_cmd=rc, krec=-1)
+        return self.nudot.copy()
+
+    def _call(self, nav=None, gov=None, hs=None, events=None, ecount=None, rud_cmd=None, krec=-1, rec=None):
+        return DY.step_forces(self.dt, self.qpos, self.qvel, self.time, self.qfrc,
+                              self.comp_kind, self.comp_off, self.comp_par, self.minv, self.mrb, self.ma,
+                              self.munk_in_hull, self.rb, self.steer, self.shaftp, self.env,
+                              self.rud_cmd if rud_cmd is None else rud_cmd, self.shaft_cmd,
+                              self.gov if gov is None else gov, self.nav if nav is None else nav,
+                              self.phases, self.hs if hs is None else hs,
+                              self.events if events is None else events,
+                              self.ecount if ecount is None else ecount,
+                              self.ctx, self.aux, self.comp_w, self.nudot, self.limits, self.status,
+                              self._no_rec if rec is None else rec, krec)
+
+    # ------------------------------------------------------------------ helm
+    def set_helm(self, ship: int, phases: list[tuple]) -> None:
+        """Give ship ``ship`` a helm program: a list of (mode, a1, ..., a7) phases."""
+        if len(phases) > H.MAX_PHASES:
+            raise ValueError(f"at most {H.MAX_PHASES} helm phases")
+        self.phases[ship] = 0.0
+        for k, ph in enumerate(phases):
+            self.phases[ship, k, :len(ph)] = ph
+        self.hs[ship] = 0.0
+        self.hs[ship, H.H_NPHASE] = len(phases)
+        self.hs[ship, H.H_TSTART] = -1.0
+        self.hs[ship, H.H_ACTIVE] = 1.0 if phases else 0.0
+
+    def helm_phase(self, ship: int) -> int:
+        return int(self.hs[ship, H.H_PHASE])
+
+    def helm_events(self, ship: int) -> np.ndarray:
+        return self.events[ship, : self.ecount[ship]].copy()
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, nstep: int = 1) -> None:
+        """Advance every ship by ``nstep`` time steps."""
+        every = self.record_every
+        for _ in range(nstep):
+            krec = -1
+            rec = self._no_rec
+            if every and self._step_count % every == 0:
+                if self._chunk is None or self._krow >= self._chunk.shape[0]:
+                    self._new_chunk()
+                krec = self._krow
+                rec = self._chunk
+                self._krow += 1
+            nbad = self._call(krec=krec, rec=rec)
+            if nbad:
+                self._raise_status()
+            self.batch.step()
+            self._step_count += 1
+
+    def check(self) -> None:
+        """Check the current states (the kernel checks each state before it is integrated)."""
+        self.evaluate()
+        if np.any(self.status != DY.OK):
+            self._raise_status()
+
+    def _raise_status(self):
+        i = int(np.flatnonzero(self.status)[0])
+        code = int(self.status[i])
+        c = self.ctx[i]
+        msg = (f"simulation stopped at t = {self.time[i]:.3f} s (ship {i}): {DY.STATUS_TEXT.get(code, code)}; "
+               f"state: position N {c[L.POS]:.2f} m, E {c[L.POS + 1]:.2f} m, z {c[L.POS + 2]:.3f} m; "
+               f"roll {deg(c[L.EUL]):.2f}°, pitch {deg(c[L.EUL + 1]):.2f}°, heading {deg(c[L.EUL + 2]):.2f}°; "
+               f"velocity through water u {c[L.NU_R]:.4g}, v {c[L.NU_R + 1]:.4g}, w {c[L.NU_R + 2]:.4g} m/s; "
+               f"rates p {c[L.NU_R + 3]:.4g}, q {c[L.NU_R + 4]:.4g}, r {c[L.NU_R + 5]:.4g} rad/s; "
+               f"accelerations {np.array2string(self.nudot[i], precision=4)}")
+        raise SimulationError(msg, time_s=float(self.time[i]), ship=i)
+
+    def _new_chunk(self):
+        if self._chunk is not None:
+            self._chunks.append(self._chunk[: self._krow])
+        self._chunk = np.zeros((4096, self.n, self.rec_width))
+        self._krow = 0
+
+    def truth(self) -> np.ndarray:
+        """All truth rows recorded so far, (K, N, width)."""
+        parts = list(self._chunks)
+        if self._chunk is not None:
+            parts.append(self._chunk[: self._krow])
+        if not parts:
+            return np.zeros((0, self.n, self.rec_width))
+        return np.concatenate(parts, axis=0)
+
+    def clear_truth(self) -> None:
+        self._chunks = []
+        self._chunk = None
+        self._krow = 0
+
+    # ------------------------------------------------------------------ steady states
+    def self_propulsion(self, ship: int, speed: float, heading: float = 0.0, trim_iterations: int = 4) -> ShipState:
+        """The calm-water steady straight-ahead condition at ``speed`` through the water.
+
+        Finds the shaft speed at which the surge forces balance (all shafts equal, rudders
+        amidships) and the heave, heel and trim at which heave force, roll and pitch moments
+        balance; returns that condition (also placed on the ship).
+        """
+        s = ShipState(heading=heading, u=speed, shaft_rps=(0.0,) * self.ns)
+        C = self.vessel.restoring_matrix()[2:5, 2:5]
+        n_hi = float(np.max([sh.max_rps for sh in self.vessel.shafts]))
+
+        def surge_residual(n):
+            s.shaft_rps = (n,) * self.ns
+            self.set_state(ship, s)
+            return float((self.mrb[ship] + self.ma[ship])[0] @ self.evaluate()[ship])
+
+        n_sp = 0.0
+        for _ in range(trim_iterations):
+            if surge_residual(n_hi) < 0:
+                raise SimulationError(f"no shaft speed up to {n_hi * 60:.1f} r/min holds {speed:.3f} m/s")
+            n_sp = brentq(surge_residual, 1e-6, n_hi, xtol=1e-13, rtol=1e-14)
+            s.shaft_rps = (n_sp,) * self.ns
+            self.set_state(ship, s)
+            F = (self.mrb[ship] + self.ma[ship]) @ self.evaluate()[ship]
+            if self.planar:
+                break
+            dz, dphi, dth = np.linalg.solve(C, F[2:5])
+            s.z += dz
+            s.roll += dphi
+            s.pitch += dth
+        s.shaft_rps = (n_sp,) * self.ns
+        self.set_state(ship, s)
+        return s

@@ -1,0 +1,138 @@
+"""Maneuver metrics computed from the TRUE state history, by their definitions.
+
+These are the references scoring compares reduced results against; they are computed from the
+true track relative to the water (position minus the integrated current), never by running a
+reduction on clean data. Definitions: IMO MSC.137(76) / MSC/Circ.1053 and ITTC 7.5-04-02-01.
+
+All inputs are SI arrays (time [s], positions [m], heading [rad, unwrapped], velocities [m/s],
+rate [rad/s]); outputs are SI except where the key says deg or dps.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _first_crossing(t: np.ndarray, f: np.ndarray, level: float, start: int = 0) -> tuple[float, int] | None:
+    """First time at index ≥ start where f reaches level from below (linear interpolation)."""
+    idx = np.flatnonzero(f[start:] >= level)
+    if idx.size == 0:
+        return None
+    k = start + int(idx[0])
+    if k == 0:
+        return float(t[0]), 0
+    f0, f1 = f[k - 1], f[k]
+    a = (level - f0) / (f1 - f0) if f1 != f0 else 1.0
+    return float(t[k - 1] + a * (t[k] - t[k - 1])), k
+
+
+def _interp(t: np.ndarray, y: np.ndarray, tq: float) -> float:
+    return float(np.interp(tq, t, y))
+
+
+def fit_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    """Least-squares circle through points (Kåsa 1976 algebraic fit, refined by Gauss–Newton on the
+    geometric distances). Returns centre x, centre y, radius."""
+    A = np.column_stack([x, y, np.ones_like(x)])
+    b = x ** 2 + y ** 2
+    sol, *_ = np.linalg.lstsq(A, b, rcond=None)
+    cx, cy = sol[0] / 2.0, sol[1] / 2.0
+    R = math.sqrt(sol[2] + cx ** 2 + cy ** 2)
+    for _ in range(20):
+        dx, dy = x - cx, y - cy
+        d = np.hypot(dx, dy)
+        res = d - R
+        J = np.column_stack([-dx / d, -dy / d, -np.ones_like(d)])
+        step, *_ = np.linalg.lstsq(J, -res, rcond=None)
+        cx, cy, R = cx + step[0], cy + step[1], R + step[2]
+        if np.max(np.abs(step)) < 1e-12 * max(1.0, abs(R)):
+            break
+    return float(cx), float(cy), float(abs(R))
+
+
+def turning(t, x_w, y_w, heading, u_r, v_r, r, *, steady_from_deg: float = 360.0,
+            steady_to_deg: float = 720.0) -> dict:
+    """Turning-circle metrics from EXECUTE (index 0 of the arrays).
+
+    advance: distance along the approach heading from EXECUTE to 90° heading change; transfer:
+    distance perpendicular to it at 90°; tactical diameter: perpendicular at 180°; steady
+    turning diameter: circle fitted to the water track between ``steady_from_deg`` and
+    ``steady_to_deg`` of heading change (the last 360° recorded if the turn is shorter);
+    steady speed and rate of turn: means over the same window.
+    """
+    t = np.asarray(t, float)
+    psi0 = heading[0]
+    dpsi = np.abs(heading - psi0)
+    c, s = math.cos(psi0), math.sin(psi0)
+    ex, ey = x_w - x_w[0], y_w - y_w[0]
+    xi = ex * c + ey * s
+    eta = -ex * s + ey * c
+    out: dict = {}
+    c90 = _first_crossing(t, dpsi, math.radians(90.0))
+    if c90 is not None:
+        out["advance_m"] = _interp(t, xi, c90[0])
+        out["transfer_m"] = abs(_interp(t, eta, c90[0]))
+        out["time_to_90deg_s"] = c90[0] - t[0]
+    c180 = _first_crossing(t, dpsi, math.radians(180.0))
+    if c180 is not None:
+        out["tactical_diameter_m"] = abs(_interp(t, eta, c180[0]))
+        out["time_to_180deg_s"] = c180[0] - t[0]
+    total = float(dpsi[-1])
+    lo, hi = math.radians(steady_from_deg), math.radians(steady_to_deg)
+    if total < hi:
+        lo, hi = total - 2 * math.pi, total
+    if lo >= math.radians(90.0):
+        m = (dpsi >= lo) & (dpsi <= hi)
+        if np.count_nonzero(m) >= 10:
+            _, _, R = fit_circle(x_w[m], y_w[m])
+            out["steady_turning_diameter_m"] = 2.0 * R
+            out["steady_speed_mps"] = float(np.mean(np.hypot(u_r[m], v_r[m])))
+            out["steady_rate_of_turn_dps"] = float(np.degrees(np.mean(np.abs(r[m]))))
+            out["steady_drift_angle_deg"] = float(np.degrees(np.mean(np.arctan2(-v_r[m], u_r[m]))))
+    return out
+
+
+def _peak(t: np.ndarray, f: np.ndarray, i0: int, i1: int) -> tuple[float, float]:
+    """Maximum of f over [i0, i1) refined by a parabola through the three samples around it."""
+    k = i0 + int(np.argmax(f[i0:i1]))
+    if 0 < k < len(f) - 1:
+        y0, y1, y2 = f[k - 1], f[k], f[k + 1]
+        den = y0 - 2 * y1 + y2
+        if den < 0:
+            d = 0.5 * (y0 - y2) / den
+            h = t[k + 1] - t[k]
+            return float(y1 - 0.25 * (y0 - y2) * d), float(t[k] + d * h)
+    return float(f[k]), float(t[k])
+
+
+def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int) -> dict:
+    """Zig-zag (δ/ψ) metrics from EXECUTE (index 0): first and second overshoot angles and times,
+    initial turning time (EXECUTE to the first heading threshold, i.e. the second execute), time
+    to check yaw, and the period (first to third threshold crossing)."""
+    t = np.asarray(t, float)
+    s = 1.0 if first_side > 0 else -1.0
+    a = math.radians(heading_deg)
+    f = s * (heading - heading[0])
+    out: dict = {"rudder_deg": rudder_deg, "heading_deg": heading_deg}
+    c1 = _first_crossing(t, f, a)
+    if c1 is None:
+        return out
+    out["initial_turning_time_s"] = c1[0] - t[0]
+    c2 = _first_crossing(t, -f, a, c1[1])
+    end1 = c2[1] if c2 is not None else len(t)
+    pk1, tp1 = _peak(t, f, c1[1], end1)
+    out["first_overshoot_deg"] = math.degrees(pk1 - a)
+    out["time_to_check_yaw_s"] = tp1 - c1[0]
+    out["first_overshoot_time_s"] = tp1 - t[0]
+    if c2 is None:
+        return out
+    c3 = _first_crossing(t, f, a, c2[1])
+    end2 = c3[1] if c3 is not None else len(t)
+    pk2, tp2 = _peak(t, -f, c2[1], end2)
+    out["second_overshoot_deg"] = math.degrees(pk2 - a)
+    out["second_overshoot_time_s"] = tp2 - t[0]
+    if c3 is not None:
+        out["period_s"] = c3[0] - c1[0]
+    return out

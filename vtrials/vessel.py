@@ -1,0 +1,388 @@
+"""Vessel models as data: ``models/<name>/ship.toml`` (every coefficient with its source) plus an
+MJCF file (hull on a free joint, rudders and shafts on hinges, instrument sites).
+
+Frames: the hull body's frame is at midship on the design waterline, x forward, y starboard,
+z down; the world is north-east-down with gravity +z. So ship conventions hold inside MuJoCo
+without sign flips: heading ψ is the yaw about world z, positive clockwise seen from above.
+
+Loading checks the parameter file (names, types, ranges, sources) and checks that the MJCF's
+rigid-body data agree with it (hull mass = ρ∇, centre of gravity, radii of gyration, shaft
+inertia), so the two files cannot silently disagree.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from . import propulsion
+from .errors import InputError
+from .forces import hull_mmg, hydrostatics, propeller_mmg, rudder_mmg
+from .schema import flag, load_toml, num, read_table, text, unknown_key
+from .units import DEG, G
+
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+
+
+@dataclasses.dataclass(frozen=True)
+class Meta:
+    name: str = text("model name (its folder name)")
+    title: str = text("one-line description")
+    mjcf: str = text("MJCF file in the model folder")
+    hull_model: str = text("hull force model", ("mmg",))
+
+
+@dataclasses.dataclass(frozen=True)
+class Particulars:
+    length: float = num("length between perpendiculars L", "m", 0.0, 500.0, lo_open=True)
+    beam: float = num("moulded beam B", "m", 0.0, 100.0, lo_open=True)
+    draught: float = num("mean draught d", "m", 0.0, 40.0, lo_open=True)
+    displacement: float = num("displacement volume ∇", "m^3", 0.0, 1e6, lo_open=True)
+    water_density: float = num("water density ρ", "kg/m^3", 990.0, 1040.0)
+    x_G: float = num("centre of gravity forward of midship", "m", -100.0, 100.0)
+    KG: float = num("centre of gravity above keel", "m", 0.0, 60.0, lo_open=True)
+
+
+@dataclasses.dataclass(frozen=True)
+class Inertia:
+    k_xx: float = num("roll radius of gyration about G", "m", 0.0, 100.0, lo_open=True)
+    k_yy: float = num("pitch radius of gyration about G", "m", 0.0, 200.0, lo_open=True)
+    k_zz: float = num("yaw radius of gyration about G", "m", 0.0, 200.0, lo_open=True)
+
+
+@dataclasses.dataclass(frozen=True)
+class Hydrostatics:
+    GM_T: float = num("transverse metacentric height", "m", 0.0, 50.0, lo_open=True)
+    GM_L: float = num("longitudinal metacentric height (about the centre of flotation)", "m", 0.0, 5000.0,
+                      lo_open=True)
+    waterplane_area: float = num("waterplane area A_wp", "m^2", 0.0, 1e5, lo_open=True)
+    x_F: float = num("centre of flotation forward of midship", "m", -100.0, 100.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class AddedMass:
+    m_x_prime: float = num("surge added mass m'_x (÷ ½ρL²d)", "", 0.0, 1.0)
+    m_y_prime: float = num("sway added mass m'_y (÷ ½ρL²d)", "", 0.0, 2.0)
+    J_z_prime: float = num("yaw added inertia J'_z (÷ ½ρL⁴d), about midship", "", 0.0, 1.0)
+    heave_ratio: float = num("heave added mass ÷ ship mass", "", 0.0, 5.0)
+    roll_ratio: float = num("roll added inertia ÷ roll inertia about G", "", 0.0, 5.0)
+    pitch_ratio: float = num("pitch added inertia ÷ pitch inertia about G", "", 0.0, 5.0)
+    munk_in_hull: bool = flag("the hull derivatives already contain the ideal-fluid (Munk) moments, "
+                              "as captive-test derivatives do: leave ν×(A ν) out of the added-mass "
+                              "Coriolis terms")
+
+
+@dataclasses.dataclass(frozen=True)
+class Damping:
+    heave_ratio: float = num("heave damping, fraction of critical", "", 0.0, 2.0)
+    roll_ratio: float = num("linear roll damping, fraction of critical", "", 0.0, 2.0)
+    pitch_ratio: float = num("pitch damping, fraction of critical", "", 0.0, 2.0)
+    roll_quadratic: float = num("quadratic roll damping B_44q (K = −B_44q |p| p)", "N m s^2", 0.0, 1e15)
+
+
+@dataclasses.dataclass(frozen=True)
+class Autopilot:
+    """The ship's heading autopilot (PID on heading error, derivative on yaw rate)."""
+
+    gain: float = num("proportional gain K_p (rudder per heading error)", "rad/rad", 0.0, 50.0, lo_open=True)
+    integral_time: float = num("integral time T_i (K_i = K_p/T_i)", "s", 0.0, 1e5, lo_open=True)
+    derivative_time: float = num("derivative time T_d (K_d = K_p T_d)", "s", 0.0, 1e4)
+    rudder_limit_deg: float = num("largest rudder the autopilot orders", "deg", 0.0, 90.0, lo_open=True)
+
+
+_SECTIONS = {"meta": Meta, "particulars": Particulars, "inertia": Inertia, "hydrostatics": Hydrostatics,
+             "added_mass": AddedMass, "damping": Damping, "autopilot": Autopilot}
+_HULLS = {"mmg": ("hull_mmg", hull_mmg.HullMMG)}
+_ARRAYS = {"propeller": propeller_mmg.PropellerMMG, "shaft": propulsion.Shaft, "rudder": rudder_mmg.RudderMMG}
+
+
+@dataclasses.dataclass
+class Component:
+    """One named force component: its dispatch kind and parameter block."""
+
+    name: str
+    kind: int
+    params: np.ndarray
+
+
+@dataclasses.dataclass
+class Vessel:
+    """A loaded, checked vessel model."""
+
+    name: str
+    folder: Path
+    toml_path: Path
+    mjcf_path: Path
+    meta: Meta
+    particulars: Particulars
+    inertia: Inertia
+    hydrostatics: Hydrostatics
+    added_mass: AddedMass
+    damping: Damping
+    autopilot: Autopilot
+    hull: object
+    propellers: list
+    shafts: list
+    rudders: list
+    sources: dict
+    model: mujoco.MjModel
+    sites: dict
+    # derived
+    mass: float = 0.0
+    r_G: np.ndarray = None
+    M_RB: np.ndarray = None
+    M_A: np.ndarray = None
+    B_lin: np.ndarray = None
+    rudder_adr: np.ndarray = None  # (nr, 2): qpos address, dof address
+    shaft_params: np.ndarray = None  # (ns, NSHAFTP)
+    steering: np.ndarray = None  # (nr, 5): max angle [rad], rate [rad/s], T [s], qadr, dadr
+    components: list = dataclasses.field(default_factory=list)
+
+    @property
+    def length(self) -> float:
+        return self.particulars.length
+
+    @property
+    def max_rudder(self) -> float:
+        """The smallest of the rudders' maximum angles [rad]."""
+        return float(np.min(self.steering[:, 0]))
+
+    @property
+    def max_rps(self) -> float:
+        return float(min(s.max_rps for s in self.shafts))
+
+    def restoring_matrix(self) -> np.ndarray:
+        """Linear hydrostatic stiffness (6×6, origin at midship waterline), for checks and tests."""
+        p, h = self.particulars, self.hydrostatics
+        rho = p.water_density
+        C = np.zeros((6, 6))
+        C[2, 2] = rho * G * h.waterplane_area
+        C[2, 4] = C[4, 2] = -rho * G * h.waterplane_area * h.x_F
+        C[3, 3] = rho * G * p.displacement * h.GM_T
+        C[4, 4] = rho * G * (p.displacement * h.GM_L + h.waterplane_area * h.x_F ** 2)
+        return C
+
+
+def model_dir(name: str) -> Path:
+    return MODELS_DIR / name
+
+
+def available_models() -> list[str]:
+    return sorted(p.name for p in MODELS_DIR.iterdir() if (p / "ship.toml").is_file())
+
+
+def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
+                field_for_errors: str = "ship") -> Vessel:
+    """Load ``models/<name>/ship.toml`` (or a path to a ship.toml) and its MJCF, checked."""
+    p = Path(name_or_path)
+    if p.suffix == ".toml" and p.is_file():
+        toml_path = p
+    else:
+        toml_path = model_dir(str(name_or_path)) / "ship.toml"
+        if not toml_path.is_file():
+            raise InputError(file_for_errors or str(name_or_path), field_for_errors,
+                             f"unknown ship {str(name_or_path)!r} (available: {', '.join(available_models())})")
+    f = str(toml_path)
+    doc = load_toml(toml_path)
+    known = list(_SECTIONS) + [v[0] for v in _HULLS.values()] + list(_ARRAYS)
+    for key in doc:
+        if key not in known:
+            raise unknown_key(f, "", key, known)
+    parts = {}
+    sources: dict[str, dict] = {}
+    for sec, cls in _SECTIONS.items():
+        if sec not in doc:
+            raise InputError(f, sec, "missing section")
+        parts[sec], sources[sec] = read_table(cls, doc[sec], f, sec, sourced=(sec != "meta"))
+    meta: Meta = parts["meta"]
+    hull_sec, hull_cls = _HULLS[meta.hull_model]
+    if hull_sec not in doc:
+        raise InputError(f, hull_sec, f"missing section (meta.hull_model is {meta.hull_model!r})")
+    hull, sources[hull_sec] = read_table(hull_cls, doc[hull_sec], f, hull_sec, sourced=True)
+    arrays: dict[str, list] = {}
+    for sec, cls in _ARRAYS.items():
+        items = doc.get(sec, [])
+        if not isinstance(items, list) or not items:
+            raise InputError(f, sec, f"expected at least one [[{sec}]] table")
+        arrays[sec] = []
+        for i, tab in enumerate(items):
+            obj, src = read_table(cls, tab, f, f"{sec}[{i}]", sourced=True)
+            arrays[sec].append(obj)
+            sources[f"{sec}[{i}]"] = src
+    vessel = _assemble(toml_path, meta, parts, hull, arrays, sources)
+    return vessel
+
+
+def _names(items, f, sec):
+    names = [it.name for it in items]
+    for i, n in enumerate(names):
+        if names.index(n) != i:
+            raise InputError(f, f"{sec}[{i}].name", f"duplicate name {n!r}")
+    return names
+
+
+def _assemble(toml_path: Path, meta: Meta, parts: dict, hull, arrays: dict, sources: dict) -> Vessel:
+    f = str(toml_path)
+    folder = toml_path.parent
+    if meta.name != folder.name:
+        raise InputError(f, "meta.name", f"{meta.name!r} differs from the model folder name {folder.name!r}")
+    mjcf_path = folder / meta.mjcf
+    if not mjcf_path.is_file():
+        raise InputError(f, "meta.mjcf", f"MJCF file {meta.mjcf!r} not found in {folder}")
+    try:
+        model = mujoco.MjModel.from_xml_path(str(mjcf_path))
+    except ValueError as exc:
+        msg = str(exc).strip().replace("\n", " ")
+        raise InputError(str(mjcf_path), "", f"MuJoCo cannot compile it: {msg}") from None
+    P: Particulars = parts["particulars"]
+    I: Inertia = parts["inertia"]
+    H: Hydrostatics = parts["hydrostatics"]
+    A: AddedMass = parts["added_mass"]
+    D: Damping = parts["damping"]
+    # --- the simulation conventions are enforced here, whatever the MJCF says
+    model.opt.gravity[:] = (0.0, 0.0, G)
+    model.opt.density = 0.0
+    model.opt.viscosity = 0.0
+    model.opt.wind[:] = 0.0
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    mf = str(mjcf_path)
+    # --- hull body and free joint
+    hull_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "hull")
+    if hull_id < 0:
+        raise InputError(mf, "body 'hull'", "missing: the hull must be a body named 'hull'")
+    if model.njnt < 1 or model.jnt_type[0] != mujoco.mjtJoint.mjJNT_FREE or model.jnt_bodyid[0] != hull_id:
+        raise InputError(mf, "body 'hull'", "the first joint must be a free joint on the hull body")
+    mass = P.water_density * P.displacement
+    z_G = P.draught - P.KG
+    r_G = np.array([P.x_G, 0.0, z_G])
+    I_G = mass * np.array([I.k_xx ** 2, I.k_yy ** 2, I.k_zz ** 2])
+
+    def mismatch(field, got, want, tol=1e-6):
+        if not np.allclose(got, want, rtol=tol, atol=tol * max(1.0, float(np.max(np.abs(want))))):
+            raise InputError(mf, field, f"{np.round(got, 6).tolist()} disagrees with ship.toml, which gives "
+                                        f"{np.round(want, 6).tolist()}")
+
+    mismatch("body 'hull' inertial mass (ρ∇)", model.body_mass[hull_id], mass)
+    mismatch("body 'hull' inertial pos (x_G, 0, draught − KG)", model.body_ipos[hull_id], r_G)
+    if not np.allclose(np.abs(model.body_iquat[hull_id]), [1, 0, 0, 0], atol=1e-9):
+        raise InputError(mf, "body 'hull' inertial", "principal axes must be the hull axes (use diaginertia)")
+    mismatch("body 'hull' inertial diaginertia (m k²)", model.body_inertia[hull_id], I_G)
+    sites = {}
+    for i in range(model.nsite):
+        nm = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, i)
+        if model.site_bodyid[i] == hull_id and nm:
+            sites[nm] = model.site_pos[i].copy()
+    # --- propellers, shafts, rudders
+    props = arrays["propeller"]
+    shafts = arrays["shaft"]
+    rudders = arrays["rudder"]
+    pnames = _names(props, f, "propeller")
+    _names(shafts, f, "shaft")
+    _names(rudders, f, "rudder")
+    from .forces.layout import MAX_RUDDERS, MAX_SHAFTS
+    if len(shafts) > MAX_SHAFTS or len(props) > MAX_SHAFTS:
+        raise InputError(f, "shaft", f"at most {MAX_SHAFTS} shafts and propellers are supported")
+    if len(rudders) > MAX_RUDDERS:
+        raise InputError(f, "rudder", f"at most {MAX_RUDDERS} rudders are supported")
+    if len(shafts) != len(props):
+        raise InputError(f, "shaft", "every propeller needs exactly one shaft")
+
+    def hinge(field, jname, axis_want):
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, jname)
+        if jid < 0:
+            raise InputError(f, field, f"joint {jname!r} not found in {mjcf_path.name}")
+        if model.jnt_type[jid] != mujoco.mjtJoint.mjJNT_HINGE:
+            raise InputError(mf, f"joint {jname!r}", "must be a hinge")
+        if model.body_parentid[model.jnt_bodyid[jid]] != hull_id:
+            raise InputError(mf, f"joint {jname!r}", "its body must be a child of the hull")
+        if not np.allclose(model.jnt_axis[jid], axis_want, atol=1e-9):
+            raise InputError(mf, f"joint {jname!r} axis", f"{model.jnt_axis[jid].tolist()} but {axis_want} is "
+                                                          f"required")
+        bid = model.jnt_bodyid[jid]
+        if model.body_mass[bid] > 1e-6 * mass:
+            raise InputError(mf, f"body of joint {jname!r}", "must be (nearly) massless: its mass belongs to "
+                                                              "the hull's inertial, its inertia to the armature")
+        return jid, int(model.jnt_qposadr[jid]), int(model.jnt_dofadr[jid])
+
+    used_props = set()
+    shaft_rows = [None] * len(props)
+    for i, s in enumerate(shafts):
+        if s.propeller not in pnames:
+            raise InputError(f, f"shaft[{i}].propeller", f"unknown propeller {s.propeller!r} (known: {pnames})")
+        if s.propeller in used_props:
+            raise InputError(f, f"shaft[{i}].propeller", f"propeller {s.propeller!r} has two shafts")
+        used_props.add(s.propeller)
+        if s.rotation not in (-1, 1):
+            raise InputError(f, f"shaft[{i}].rotation", "must be +1 or -1")
+        jid, qadr, dadr = hinge(f"shaft[{i}].joint", s.joint, [float(s.rotation), 0.0, 0.0])
+        mismatch(f"joint {s.joint!r} armature (shaft[{i}].inertia)", model.dof_armature[dadr], s.inertia)
+        k = pnames.index(s.propeller)
+        shaft_rows[k] = propulsion.pack(s, k, qadr, dadr)
+    shaft_params = np.vstack(shaft_rows)
+    rudder_adr = []
+    steering = []
+    for i, r in enumerate(rudders):
+        if r.propeller not in pnames:
+            raise InputError(f, f"rudder[{i}].propeller", f"unknown propeller {r.propeller!r} (known: {pnames})")
+        jid, qadr, dadr = hinge(f"rudder[{i}].joint", r.joint, [0.0, 0.0, -1.0])
+        rudder_adr.append((qadr, dadr))
+        steering.append([r.max_angle_deg * DEG, r.rate_deg_s * DEG, r.time_constant, qadr, dadr,
+                         model.dof_armature[dadr]])
+        if model.dof_armature[dadr] <= 0:
+            raise InputError(mf, f"joint of rudder[{i}]", "needs a positive armature (rudder stock inertia)")
+    v = Vessel(name=meta.name, folder=folder, toml_path=toml_path, mjcf_path=mjcf_path, meta=meta,
+               particulars=P, inertia=I, hydrostatics=H, added_mass=A, damping=D,
+               autopilot=parts["autopilot"], hull=hull,
+               propellers=props, shafts=shafts, rudders=rudders, sources=sources, model=model, sites=sites)
+    v.mass = mass
+    v.r_G = r_G
+    v.rudder_adr = np.array(rudder_adr, dtype=np.int64)
+    v.shaft_params = shaft_params
+    v.steering = np.array(steering, dtype=np.float64)
+    _derive(v)
+    return v
+
+
+def _derive(v: Vessel) -> None:
+    """Rigid-body and added-mass matrices, damping, and the component list."""
+    P, I, H, A, D = v.particulars, v.inertia, v.hydrostatics, v.added_mass, v.damping
+    model = v.model
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    Mfull = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, Mfull)
+    v.M_RB = Mfull[:6, :6].copy()
+    rho, Lpp, d = P.water_density, P.length, P.draught
+    half = 0.5 * rho * Lpp ** 2 * d
+    I_G = v.mass * np.array([I.k_xx ** 2, I.k_yy ** 2, I.k_zz ** 2])
+    M_A = np.diag([A.m_x_prime * half, A.m_y_prime * half, A.heave_ratio * v.mass,
+                   A.roll_ratio * I_G[0], A.pitch_ratio * I_G[1], A.J_z_prime * half * Lpp ** 2])
+    v.M_A = M_A
+    C = v.restoring_matrix()
+    Mtot = v.M_RB + M_A
+    B = np.zeros(3)
+    for j, (dof, zeta) in enumerate(((2, D.heave_ratio), (3, D.roll_ratio), (4, D.pitch_ratio))):
+        B[j] = 2.0 * zeta * math.sqrt(Mtot[dof, dof] * C[dof, dof])
+    v.B_lin = B
+    u_floor = 1e-3 * math.sqrt(G * Lpp)
+    comps = [Component("hull", hull_mmg.KIND, hull_mmg.pack(v.hull, Lpp, d, rho, u_floor))]
+    pnames = [p.name for p in v.propellers]
+    for k, pr in enumerate(v.propellers):
+        comps.append(Component(f"propeller:{pr.name}", propeller_mmg.KIND,
+                               propeller_mmg.pack(pr, k, Lpp, rho, u_floor)))
+    for k, rd in enumerate(v.rudders):
+        kp = pnames.index(rd.propeller)
+        comps.append(Component(f"rudder:{rd.name}", rudder_mmg.KIND,
+                               rudder_mmg.pack(rd, k, kp, v.propellers[kp].diameter, Lpp, rho, u_floor,
+                                               v.hull.z_H)))
+    comps.append(Component("hydrostatics", hydrostatics.KIND_RESTORING,
+                           hydrostatics.pack_restoring(v.mass, G, rho, P.displacement, H.waterplane_area, H.x_F,
+                                                       H.GM_T, H.GM_L, v.r_G)))
+    comps.append(Component("damping", hydrostatics.KIND_DAMPING,
+                           hydrostatics.pack_damping(B[0], B[1], B[2], D.roll_quadratic)))
+    v.components = comps
