@@ -6,6 +6,39 @@ the truth is recorded and every result is scored against it. Start with :func:`r
 
 __version__ = "0.1.0"
 
+
+def _numba_cache_dir() -> None:
+    """Point numba's on-disk cache at a directory keyed by the hash of this package's sources.
+
+    numba invalidates a cached kernel only when the kernel's own file changes, not when a kernel it
+    calls (in another module) does; keying the whole cache on all sources rules out stale kernels.
+    """
+    import hashlib
+    import os
+    from pathlib import Path
+
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    h = hashlib.sha256()
+    pkg = Path(__file__).resolve().parent
+    for f in sorted(pkg.rglob("*.py")):
+        h.update(f.relative_to(pkg).as_posix().encode())
+        h.update(f.read_bytes())
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "vtrials" / "numba"
+    d = base / h.hexdigest()[:16]
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return
+    import numba
+
+    numba.config.CACHE_DIR = str(d)
+
+
+_numba_cache_dir()
+# numba's OpenMP workers must not spin between kernel calls: MuJoCo's batch threads need the cores
+__import__("os").environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 from .errors import InputError, SimulationError, VtrialsError  # noqa: E402
 from .run import RunResult, run, simulate  # noqa: E402
 from .scenario import load_scenario  # noqa: E402

@@ -24,6 +24,7 @@ For every ship, each step:
 from __future__ import annotations
 
 import math
+import types
 
 import numba as nb
 import numpy as np
@@ -126,32 +127,33 @@ def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[s
     return names
 
 
-@nb.njit(cache=True)
-def step_forces(dt, qpos, qvel, time, qfrc,
-                comp_kind, comp_off, comp_par, minv, mrb, ma, munk_in_hull, rb, steer, shaftp, env,
-                rud_cmd, shaft_cmd, gov, nav, phases, hs, events, ecount,
-                ctx, aux, comp_w, nudot, limits, status, rec, krec):
+def _step_forces(dt, qpos, qvel, time, qfrc,
+                 comp_kind, comp_off, comp_par, minv, mrb, ma, munk_in_hull, rb, steer, shaftp, env,
+                 rud_cmd, shaft_cmd, gov, nav, phases, hs, events, ecount,
+                 ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch):
     """Compute MuJoCo's applied generalized forces for every ship; see the module docstring.
 
-    Returns the number of ships whose status is not OK.
+    Returns the number of ships whose status is not OK. ``scratch`` is an (N, 64) work array.
+    Compiled twice: serially (``prange`` is then ``range``) and with the ships spread over threads;
+    each ship's arithmetic is the same either way, so results are bit-identical.
     """
-    N = qpos.shape[0]
-    C = comp_kind.shape[0]
-    nr = steer.shape[0]
-    ns = shaftp.shape[0]
     nbad = 0
-    R = np.empty(9)
-    nu1 = np.empty(3)
-    om = np.empty(3)
-    nu1r = np.empty(3)
-    cvec = np.empty(6)
-    tau = np.empty(6)
-    rhs = np.empty(6)
-    acc = np.empty(6)
-    crb = np.empty(6)
-    frc = np.empty(6)
-    grav = np.empty(6)
-    for i in range(N):
+    for i in nb.prange(qpos.shape[0]):
+        C = comp_kind.shape[0]
+        nr = steer.shape[0]
+        ns = shaftp.shape[0]
+        sc = scratch[i]
+        R = sc[0:9]
+        nu1 = sc[9:12]
+        om = sc[12:15]
+        nu1r = sc[15:18]
+        cvec = sc[18:24]
+        tau = sc[24:30]
+        rhs = sc[30:36]
+        acc = sc[36:42]
+        crb = sc[42:48]
+        frc = sc[48:54]
+        grav = sc[54:60]
         c = ctx[i]
         a = aux[i]
         t = time[i]
@@ -204,6 +206,9 @@ def step_forces(dt, qpos, qvel, time, qfrc,
             c[L.ROT + j] = R[j]
         c[L.CUR] = vcn
         c[L.CUR + 1] = vce
+        # material (fluid-particle) acceleration of the current: ∂V/∂t + (V·∇)V
+        c[L.CUR_ACC] = acn + e[9] * vcn + e[10] * vce
+        c[L.CUR_ACC + 1] = ace + e[11] * vcn + e[12] * vce
         # --- helm: one order for all rudders
         if nr > 0:
             order = H.helm_step(i, t, psi_u, om[2], dt, phases, hs, events, ecount, rud_cmd[i, 0])
@@ -242,10 +247,10 @@ def step_forces(dt, qpos, qvel, time, qfrc,
         wr[3] = qreact
         tau[3] += qreact
         # --- exact added-mass solve
-        m = rb[i, 0]
-        gb0 = m * 9.80665 * R[6]
-        gb1 = m * 9.80665 * R[7]
-        gb2 = m * 9.80665 * R[8]
+        mg = rb[i, 0] * rb[i, 4]
+        gb0 = mg * R[6]
+        gb1 = mg * R[7]
+        gb2 = mg * R[8]
         grav[0] = gb0
         grav[1] = gb1
         grav[2] = gb2
@@ -312,8 +317,6 @@ def step_forces(dt, qpos, qvel, time, qfrc,
             elif abs(om[0]) > limits[LIM_RATE] or abs(om[1]) > limits[LIM_RATE] or abs(om[2]) > limits[LIM_RATE]:
                 st_code = RATE_RUNAWAY
         status[i] = st_code
-        if st_code != OK:
-            nbad += 1
         # --- truth record row (state before this step's integration)
         if krec >= 0:
             row = rec[krec, i]
@@ -361,4 +364,19 @@ def step_forces(dt, qpos, qvel, time, qfrc,
         # water-relative drift: Σ dt V_C (the water track is position minus this)
         nav[i, NV_DN] += dt * vcn
         nav[i, NV_DE] += dt * vce
+        if st_code != OK:
+            nbad += 1
     return nbad
+
+
+def _twin(f, name):
+    """A copy of function f under another name: numba's cache is keyed by the function's name, so
+    the serial and threaded compilations of one source must not share it."""
+    g = types.FunctionType(f.__code__, f.__globals__, name, f.__defaults__, f.__closure__)
+    g.__qualname__ = name
+    g.__doc__ = f.__doc__
+    return g
+
+
+step_forces = nb.njit(cache=True)(_step_forces)
+step_forces_parallel = nb.njit(cache=True, parallel=True)(_twin(_step_forces, "_step_forces_parallel"))

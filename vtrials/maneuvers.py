@@ -102,7 +102,8 @@ class Williamson:
     deviation_deg: float = num("heading change at which the rudder is reversed", "deg", 10.0, 120.0, default=60.0)
     window_deg: float = num("hand over to the autopilot this far short of the reciprocal", "deg", 0.0, 90.0,
                             default=20.0)
-    settle_s: float = num("time on autopilot after hand-over before FINEX", "s", 0.0, 1e5, default=None)
+    settle_s: float = num("time on autopilot after hand-over before FINEX (default: 10 L/U)", "s", 0.0, 1e5,
+                          default=None)
     approach_s: float = num("steady approach before EXECUTE (default: 3 L/U)", "s", 0.0, 1e5, default=None)
     max_duration_s: float = num("give up if FINEX is not reached within this time after EXECUTE", "s", 1.0, 1e6,
                                 default=None)

@@ -124,7 +124,7 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
             phase = sim.helm_phase(i)
             tstart = sim.hs[i, H.H_TSTART]
             pe = float(sim.time[i]) - tstart if tstart >= 0 else 0.0
-            prog = Progress(elapsed, float(sim.nav[i, 0]) - psi_exec[i], phase, pe, 3.0 * L_over_U)
+            prog = Progress(elapsed, float(sim.nav[i, 0]) - psi_exec[i], phase, pe, 10.0 * L_over_U)
             if scn.maneuvers[i].finished(prog):
                 t_finex[i] = float(sim.time[i])
                 completed[i] = True

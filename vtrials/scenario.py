@@ -30,7 +30,7 @@ from .vessel import Vessel, load_vessel
 @dataclasses.dataclass(frozen=True)
 class Head:
     title: str = text("one-line description of the scenario")
-    ship: str = text("vessel model: a folder under models/ (e.g. kvlcc2_l7)")
+    ship: str = text("vessel model: a name under models/ (e.g. kvlcc2_l7) or a model folder path")
     seed: int = integer("seed of every random draw in the run (records are reproducible from it)", 0, 2 ** 63 - 1)
     timestep_s: float = num("simulation time step", "s", 0.0, 1.0, lo_open=True)
     planar: bool = flag("hold heave, roll and pitch at zero (3-DOF validation mode)", default=False)
@@ -92,7 +92,10 @@ def load_scenario(path: str | Path) -> Scenario:
     if "scenario" not in doc:
         raise InputError(f, "scenario", "missing table [scenario]")
     head, _ = read_table(Head, doc["scenario"], f, "scenario")
-    vessel = load_vessel(head.ship, file_for_errors=f, field_for_errors="scenario.ship")
+    ship = head.ship
+    if "/" in ship or ship.endswith(".toml"):  # a model folder of the user's, relative to the scenario
+        ship = str((p.parent / ship).resolve())
+    vessel = load_vessel(ship, file_for_errors=f, field_for_errors="scenario.ship")
     init, _ = read_table(Initial, doc.get("initial", {}), f, "initial")
     given = [k for k in ("froude_number", "speed_kn", "speed_mps") if getattr(init, k) is not None]
     if len(given) != 1:

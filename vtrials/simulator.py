@@ -30,6 +30,9 @@ from .units import G, deg
 from .vessel import Vessel
 
 
+PARALLEL_FROM = 8  # batches at least this large use the threaded kernel (when nthread > 1)
+
+
 @dataclasses.dataclass
 class ShipState:
     """A ship's initial condition (SI; velocities through the water, body axes)."""
@@ -71,28 +74,31 @@ class Simulator:
     nthread: MuJoCo batch threads (results are identical for any value).
     record_every: write a truth row every this many steps (0: no truth recording).
     planar: hold heave, roll and pitch at zero (a 3-DOF validation mode).
+    components: replace the vessel's force components (tests, system identification).
+    gravity: magnitude of gravity [m/s²] (0 for ideal-fluid checks).
     """
 
     def __init__(self, vessel: Vessel, n_ships: int = 1, dt: float = 0.01, envs=None, nthread: int = 1,
                  record_every: int = 1, limits: tuple[float, float, float] | None = None,
-                 planar: bool = False):
+                 planar: bool = False, components: list | None = None, gravity: float = G):
         self.vessel = vessel
         self.n = int(n_ships)
         self.dt = float(dt)
         model = copy.copy(vessel.model)
         model.opt.timestep = self.dt
+        model.opt.gravity[:] = (0.0, 0.0, gravity)
         self.model = model
         self.batch = mjbatch.Batch(model, self.n, nthread=nthread)
         self.qpos = self.batch.bind("qpos")
         self.qvel = self.batch.bind("qvel")
         self.qfrc = self.batch.bind("qfrc_applied")
         self.time = self.batch.bind("time")
-        comps = vessel.components
+        comps = vessel.components if components is None else components
         self.comp_names = [c.name for c in comps]
         self.comp_kind = np.array([c.kind for c in comps], dtype=np.int64)
         offs = np.cumsum([0] + [len(c.params) for c in comps])
         self.comp_off = offs.astype(np.int64)
-        self.comp_par = np.tile(np.concatenate([c.params for c in comps]), (self.n, 1))
+        self.comp_par = np.tile(np.concatenate([np.zeros(0)] + [c.params for c in comps]), (self.n, 1))
         Mtot = vessel.M_RB + vessel.M_A
         self.planar = bool(planar)
         if self.planar:
@@ -106,7 +112,7 @@ class Simulator:
         self.mrb = np.tile(vessel.M_RB, (self.n, 1, 1))
         self.ma = np.tile(vessel.M_A, (self.n, 1, 1))
         self.munk_in_hull = 1 if vessel.added_mass.munk_in_hull else 0
-        self.rb = np.tile(np.array([vessel.mass, *vessel.r_G]), (self.n, 1))
+        self.rb = np.tile(np.array([vessel.mass, *vessel.r_G, gravity]), (self.n, 1))
         self.steer = np.ascontiguousarray(vessel.steering)
         self.shaftp = np.ascontiguousarray(vessel.shaft_params)
         self.nr = self.steer.shape[0]
@@ -125,6 +131,9 @@ class Simulator:
         self.comp_w = np.zeros((self.n, len(comps) + 1, 6))
         self.nudot = np.zeros((self.n, 6))
         self.status = np.zeros(self.n, dtype=np.int64)
+        self.scratch = np.zeros((self.n, 64))
+        # many ships: the same per-ship kernel spread over threads (bit-identical results)
+        self._kernel = DY.step_forces_parallel if (self.n >= PARALLEL_FROM and nthread > 1) else DY.step_forces
         Lpp = vessel.length
         if limits is None:
             # runaway limits: Fn 2 through the water, 70° heel or trim, 3 rad/s
@@ -195,7 +204,7 @@ class Simulator:
         return self.nudot.copy()
 
     def _call(self, nav=None, gov=None, hs=None, events=None, ecount=None, rud_cmd=None, krec=-1, rec=None):
-        return DY.step_forces(self.dt, self.qpos, self.qvel, self.time, self.qfrc,
+        return self._kernel(self.dt, self.qpos, self.qvel, self.time, self.qfrc,
                               self.comp_kind, self.comp_off, self.comp_par, self.minv, self.mrb, self.ma,
                               self.munk_in_hull, self.rb, self.steer, self.shaftp, self.env,
                               self.rud_cmd if rud_cmd is None else rud_cmd, self.shaft_cmd,
@@ -204,7 +213,7 @@ class Simulator:
                               self.events if events is None else events,
                               self.ecount if ecount is None else ecount,
                               self.ctx, self.aux, self.comp_w, self.nudot, self.limits, self.status,
-                              self._no_rec if rec is None else rec, krec)
+                              self._no_rec if rec is None else rec, krec, self.scratch)
 
     # ------------------------------------------------------------------ helm
     def set_helm(self, ship: int, phases: list[tuple]) -> None:

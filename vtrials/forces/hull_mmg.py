@@ -6,8 +6,9 @@ used is the velocity relative to the water. The hull lateral force and surge for
 act at depth ``z_H`` below the waterline, which gives the heel moment in a turn (an assumption of
 this project: MMG is a horizontal-plane model and names no vertical centre).
 
-Validity: ahead motion (u > 0). Near U = 0 the non-dimensional rates blow up; ``U`` is floored
-at ``u_floor`` so the kernel stays finite, but low-speed maneuvers need a low-speed hull model.
+Validity: ahead motion (u > 0). The terms are evaluated multiplied out (e.g. Y'_v v' U² = Y'_v v U) so
+that the hull is force-free at rest; where U divides, it is floored at ``u_floor`` so the kernel stays
+finite, but low-speed maneuvers need a low-speed hull model.
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ def pack(h: HullMMG, length: float, draught: float, rho: float, u_floor: float) 
                      h.N_v, h.N_r, h.N_vvv, h.N_vvr, h.N_vrr, h.N_rrr, h.z_H], dtype=np.float64)
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def kernel(p, env, ctx, aux, w):
     Lpp = p[0]
     d = p[1]
@@ -63,17 +64,18 @@ def kernel(p, env, ctx, aux, w):
     u = ctx[L.NU_R + 0]
     v = ctx[L.NU_R + 1]
     r = ctx[L.NU_R + 5]
-    U = math.sqrt(u * u + v * v)
-    if U < p[3]:
-        U = p[3]
-    vp = v / U
-    rp = r * Lpp / U
-    q = 0.5 * rho * Lpp * d * U * U
-    X = q * (-p[4] + p[5] * vp * vp + p[6] * vp * rp + p[7] * rp * rp + p[8] * vp ** 4)
-    Y = q * (p[9] * vp + p[10] * rp + p[11] * vp ** 3 + p[12] * vp * vp * rp
-             + p[13] * vp * rp * rp + p[14] * rp ** 3)
-    N = q * Lpp * (p[15] * vp + p[16] * rp + p[17] * vp ** 3 + p[18] * vp * vp * rp
-                   + p[19] * vp * rp * rp + p[20] * rp ** 3)
+    U2 = u * u + v * v
+    Ud = math.sqrt(U2)
+    if Ud < p[3]:
+        Ud = p[3]  # floor only where U divides: at rest every term is zero
+    rl = r * Lpp
+    h = 0.5 * rho * Lpp * d
+    # ½ρLdU²·(polynomial in v' = v/U, r' = rL/U), multiplied out
+    X = h * (-p[4] * U2 + p[5] * v * v + p[6] * v * rl + p[7] * rl * rl + p[8] * v ** 4 / (Ud * Ud))
+    Y = h * (p[9] * v * Ud + p[10] * rl * Ud + (p[11] * v ** 3 + p[12] * v * v * rl
+                                                 + p[13] * v * rl * rl + p[14] * rl ** 3) / Ud)
+    N = h * Lpp * (p[15] * v * Ud + p[16] * rl * Ud + (p[17] * v ** 3 + p[18] * v * v * rl
+                                                       + p[19] * v * rl * rl + p[20] * rl ** 3) / Ud)
     zH = p[21]
     w[0] = X
     w[1] = Y

@@ -10,6 +10,11 @@ surface vessel):
   −ρ g A_wp x_F and the A_wp x_F² part of pitch stiffness about the origin;
 * roll: a couple −ρ g ∇ GM_T sin φ; pitch: a couple −ρ g ∇ GM_L sin θ (GM_L about F).
 
+Froude–Krylov force of an accelerating current: the horizontal pressure gradient that accelerates
+the water, −∇p = ρ DV_C/Dt, acts on the displaced volume, a force ρ∇ DV_C/Dt at the centre of
+buoyancy B (x_G, 0, d − KB). With the added-mass term of the dynamics it makes a ship without
+thrust move with the water, as it must.
+
 Damping: linear in the heave, roll and pitch velocities relative to the water, B_ii set from
 damping ratios of the uncoupled modes (see :mod:`vtrials.vessel`), plus an optional quadratic roll
 term B_44q |p| p.
@@ -29,8 +34,8 @@ KIND_DAMPING = 5
 
 
 def pack_restoring(mass: float, g: float, rho: float, volume: float, waterplane_area: float,
-                   x_F: float, GM_T: float, GM_L: float, r_G: np.ndarray) -> np.ndarray:
-    return np.array([mass, g, rho, volume, waterplane_area, x_F, GM_T, GM_L, r_G[0], r_G[1], r_G[2]],
+                   x_F: float, GM_T: float, GM_L: float, r_G: np.ndarray, z_B: float) -> np.ndarray:
+    return np.array([mass, g, rho, volume, waterplane_area, x_F, GM_T, GM_L, r_G[0], r_G[1], r_G[2], z_B],
                     dtype=np.float64)
 
 
@@ -38,7 +43,7 @@ def pack_damping(B33: float, B44: float, B55: float, B44q: float) -> np.ndarray:
     return np.array([B33, B44, B55, B44q], dtype=np.float64)
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def restoring_kernel(p, env, ctx, aux, w):
     m = p[0]
     g = p[1]
@@ -69,17 +74,25 @@ def restoring_kernel(p, env, ctx, aux, w):
     hy = Fh * ey
     hz = Fh * ez
     # moment of (hx, hy, hz) at (xF, 0, 0): r × f = (0*hz - 0*hy, 0*hx - xF*hz, xF*hy - 0*hx)
+    # Froude-Krylov force of the current's acceleration, at B = (x_G, y_G, z_B)
+    an = ctx[L.CUR_ACC]
+    ae = ctx[L.CUR_ACC + 1]
+    mf = rho * vol
+    ax = mf * (ctx[L.ROT + 0] * an + ctx[L.ROT + 3] * ae)
+    ay = mf * (ctx[L.ROT + 1] * an + ctx[L.ROT + 4] * ae)
+    az = mf * (ctx[L.ROT + 2] * an + ctx[L.ROT + 5] * ae)
+    zB = p[11]
     phi = ctx[L.EUL + 0]
     theta = ctx[L.EUL + 1]
-    w[0] = fx + hx
-    w[1] = fy + hy
-    w[2] = fz + hz
-    w[3] = kx - rho * g * vol * GMT * math.sin(phi)
-    w[4] = ky - xF * hz - rho * g * vol * GML * math.sin(theta)
-    w[5] = kz + xF * hy
+    w[0] = fx + hx + ax
+    w[1] = fy + hy + ay
+    w[2] = fz + hz + az
+    w[3] = kx - rho * g * vol * GMT * math.sin(phi) + yG * az - zB * ay
+    w[4] = ky - xF * hz - rho * g * vol * GML * math.sin(theta) + zB * ax - xG * az
+    w[5] = kz + xF * hy + xG * ay - yG * ax
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def damping_kernel(p, env, ctx, aux, w):
     wr = ctx[L.NU_R + 2]
     pr = ctx[L.NU_R + 3]

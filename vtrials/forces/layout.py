@@ -21,7 +21,8 @@ TIME = 18  # simulated time [s]
 DEPTH = 19  # water depth [m]
 ROT = 20  # 20..28: rotation matrix body→world, row major
 CUR = 29  # 29..30: current velocity north, east at the origin [m/s]
-WIND = 31  # 31..38: reserved for wind (relative speed, direction, ...)
+CUR_ACC = 31  # 31..32: material acceleration of the current, north, east [m/s²]
+WIND = 33  # 33..39: reserved for wind (relative speed, direction, ...)
 DELTA = 40  # 40..43: rudder angles [rad], positive turns the ship to starboard
 DELTA_DOT = 44  # 44..47: rudder rates [rad/s]
 SHAFT_N = 48  # 48..51: shaft speeds [rev/s], positive = ahead rotation

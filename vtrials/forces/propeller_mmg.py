@@ -57,7 +57,7 @@ def wake_factor(beta_p, C1, C2_pos, C2_neg):
     return 1.0 + (1.0 - math.exp(-C1 * abs(beta_p))) * (C2 - 1.0)
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def kernel(p, env, ctx, aux, w):
     k = int(p[0])
     Lpp = p[1]

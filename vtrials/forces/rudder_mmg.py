@@ -57,7 +57,7 @@ def pack(rd: RudderMMG, index: int, prop_index: int, prop_diameter: float, lengt
                      rd.epsilon, rd.kappa, rd.f_alpha, prop_diameter, z_hull], dtype=np.float64)
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def kernel(p, env, ctx, aux, w):
     k = int(p[0])
     kp = int(p[1])
@@ -73,10 +73,7 @@ def kernel(p, env, ctx, aux, w):
     v = ctx[L.NU_R + 1]
     r = ctx[L.NU_R + 5]
     U = math.sqrt(u * u + v * v)
-    if U < p[4]:
-        U = p[4]
     beta = math.atan2(-v, u)
-    rp = r * Lpp / U
     delta = ctx[L.DELTA + k]
     b = L.AUX_PROP + 8 * kp
     KT = aux[b + L.P_KT]
@@ -88,9 +85,10 @@ def kernel(p, env, ctx, aux, w):
         jet = 0.0
     slip = uP + p[17] * (math.sqrt(jet) - uP)
     uR = p[16] * math.sqrt(eta * slip * slip + (1.0 - eta) * uP * uP)
-    beta_R = beta - p[15] * rp
-    gamma = p[13] if beta_R < 0.0 else p[14]
-    vR = U * gamma * beta_R
+    # v_R = U γ_R β_R with β_R = β − l'_R r', multiplied out: γ_R (U β − l'_R r L)
+    UbR = U * beta - p[15] * r * Lpp
+    gamma = p[13] if UbR < 0.0 else p[14]
+    vR = gamma * UbR
     alpha = delta - math.atan2(vR, uR)
     UR2 = uR * uR + vR * vR
     FN = 0.5 * rho * AR * UR2 * p[18] * math.sin(alpha)
