@@ -31,7 +31,7 @@ import numpy as np
 
 from . import helm as H
 from . import propulsion as PR
-from .forces import hull_mmg, hydrostatics, propeller_mmg, rudder_mmg
+from .forces import hull_mmg, hydrostatics, propeller, rudder_mmg
 from .forces import layout as L
 from .sea import E_DEPTH, current_at
 
@@ -53,8 +53,8 @@ LIM_SPEED, LIM_ANGLE, LIM_RATE = 0, 1, 2
 def dispatch(kind, p, env, ctx, aux, w):
     if kind == hull_mmg.KIND:
         hull_mmg.kernel(p, env, ctx, aux, w)
-    elif kind == propeller_mmg.KIND:
-        propeller_mmg.kernel(p, env, ctx, aux, w)
+    elif kind == propeller.KIND:
+        propeller.kernel(p, env, ctx, aux, w)
     elif kind == rudder_mmg.KIND:
         rudder_mmg.kernel(p, env, ctx, aux, w)
     elif kind == hydrostatics.KIND_RESTORING:
@@ -107,8 +107,18 @@ def coriolis(M, nu1, om, munk, out):
         out[5] += nu1[0] * P1 - nu1[1] * P0
 
 
+@nb.njit(cache=True)
+def _clip(x, lim):
+    """x limited to [−lim, lim]."""
+    if x > lim:
+        return lim
+    if x < -lim:
+        return -lim
+    return x
+
+
 def record_width(n_rudders: int, n_shafts: int, n_components: int) -> int:
-    return 30 + 2 * n_rudders + 3 * n_shafts + 3 * n_shafts + n_rudders + 6 * (n_components + 1)
+    return 30 + 2 * n_rudders + 5 * n_shafts + 3 * n_shafts + n_rudders + 6 * (n_components + 1)
 
 
 def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[str]:
@@ -119,6 +129,7 @@ def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[s
     names += [f"rudder_{k}" for k in range(n_rudders)] + [f"rudder_order_{k}" for k in range(n_rudders)]
     names += [f"shaft_n_{k}" for k in range(n_shafts)] + [f"shaft_order_{k}" for k in range(n_shafts)]
     names += [f"engine_torque_{k}" for k in range(n_shafts)]
+    names += [f"pitch_{k}" for k in range(n_shafts)] + [f"pitch_order_{k}" for k in range(n_shafts)]
     for k in range(n_shafts):
         names += [f"thrust_{k}", f"prop_torque_{k}", f"advance_ratio_{k}"]
     names += [f"rudder_normal_force_{k}" for k in range(n_rudders)]
@@ -129,7 +140,7 @@ def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[s
 
 def _step_forces(dt, qpos, qvel, time, qfrc,
                  comp_kind, comp_off, comp_par, minv, mrb, ma, munk_in_hull, rb, steer, shaftp, env,
-                 rud_cmd, shaft_cmd, gov, nav, phases, hs, events, ecount,
+                 rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events, ecount,
                  ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch):
     """Compute MuJoCo's applied generalized forces for every ship; see the module docstring.
 
@@ -217,22 +228,36 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
         for k in range(nr):
             c[L.DELTA + k] = qpos[i, int(steer[k, 3])]
             c[L.DELTA_DOT + k] = qvel[i, int(steer[k, 4])]
-        qreact = 0.0
+        # --- machinery before the forces: pitch actuators, set-point ramps, engine torque
         for k in range(ns):
             sp = shaftp[k]
+            ms = mach[i, k]
             n = qvel[i, int(sp[PR.S_DADR])] / (2.0 * math.pi)
-            q_e, dint, qmax = PR.engine_torque(sp, n, shaft_cmd[i, k], gov[i, k])
             kp = int(sp[PR.S_PROP])
             c[L.SHAFT_N + kp] = n
-            c[L.Q_ENGINE + k] = q_e
-            qreact -= sp[PR.S_ROT] * q_e
-            # governor integrator, clamped to the torque available (anti-windup)
-            gi = gov[i, k] + dt * dint
-            if gi > qmax:
-                gi = qmax
-            elif gi < -qmax:
-                gi = -qmax
-            gov[i, k] = gi
+            if sp[PR.S_CP] > 0.0:
+                pc = pitch_cmd[i, k]
+                if pc > sp[PR.S_PITCH_MAX]:
+                    pc = sp[PR.S_PITCH_MAX]
+                elif pc < sp[PR.S_PITCH_MIN]:
+                    pc = sp[PR.S_PITCH_MIN]
+                ms[PR.M_PITCH] += _clip(pc - ms[PR.M_PITCH], sp[PR.S_PITCH_RATE] * dt)
+            else:
+                ms[PR.M_PITCH] = sp[PR.S_PITCH_DESIGN]
+            c[L.PITCH + kp] = ms[PR.M_PITCH]
+            ms[PR.M_SETPOINT] += _clip(shaft_cmd[i, k] - ms[PR.M_SETPOINT], sp[PR.S_NRATE] * dt)
+            mode = int(shaft_mode[i, k])
+            if mode == PR.GOVERNED:
+                q_t, dint, qmax = PR.engine_torque(sp, n, ms[PR.M_SETPOINT], ms[PR.M_INTEG])
+                qe = ms[PR.M_TORQUE] + _clip(q_t - ms[PR.M_TORQUE], sp[PR.S_TRATE] * dt)
+                qe = _clip(qe, qmax)
+                ms[PR.M_TORQUE] = qe
+                # governor integrator, clamped to the torque available (anti-windup)
+                ms[PR.M_INTEG] = _clip(ms[PR.M_INTEG] + dt * dint, qmax)
+            else:
+                ms[PR.M_TORQUE] = 0.0
+                ms[PR.M_INTEG] = 0.0
+            c[L.Q_ENGINE + k] = ms[PR.M_TORQUE]
         # --- force components
         for j in range(6):
             tau[j] = 0.0
@@ -241,6 +266,20 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
             dispatch(comp_kind[ci], comp_par[i, comp_off[ci]:comp_off[ci + 1]], e, c, a, wc)
             for j in range(6):
                 tau[j] += wc[j]
+        # --- machinery torque on each shaft, and its reaction on the hull
+        qreact = 0.0
+        for k in range(ns):
+            sp = shaftp[k]
+            kp = int(sp[PR.S_PROP])
+            n = c[L.SHAFT_N + kp]
+            qp = a[L.AUX_PROP + 8 * kp + L.P_TORQUE]
+            if int(shaft_mode[i, k]) == PR.LOCKED:
+                # the brake holds the shaft: it stops it within one step and then carries the load
+                qm = -sp[PR.S_INERTIA] * 2.0 * math.pi * n / dt + qp + sp[PR.S_FRICTION] * n
+            else:
+                qm = c[L.Q_ENGINE + k]
+            c[L.Q_ENGINE + k] = qm
+            qreact -= sp[PR.S_ROT] * qm
         wr = comp_w[i, C]
         for j in range(6):
             wr[j] = 0.0
@@ -295,7 +334,7 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
             elif rate < -steer[k, 1]:
                 rate = -steer[k, 1]
             qfrc[i, int(steer[k, 4])] = steer[k, 5] * (rate - c[L.DELTA_DOT + k]) / dt
-        # --- shafts: I ω̇ = Q_E − Q_P − c_F n
+        # --- shafts: I ω̇ = Q_M − Q_P − c_F n
         for k in range(ns):
             sp = shaftp[k]
             kp = int(sp[PR.S_PROP])
@@ -348,7 +387,9 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
                 row[o + k] = c[L.SHAFT_N + kp]
                 row[o + ns + k] = shaft_cmd[i, k]
                 row[o + 2 * ns + k] = c[L.Q_ENGINE + k]
-            o += 3 * ns
+                row[o + 3 * ns + k] = c[L.PITCH + kp]
+                row[o + 4 * ns + k] = pitch_cmd[i, k]
+            o += 5 * ns
             for k in range(ns):
                 b = L.AUX_PROP + 8 * k
                 row[o + 3 * k] = a[b + L.P_THRUST]

@@ -23,7 +23,8 @@ from . import dynamics as DY
 from . import helm as H
 from .errors import SimulationError
 from .forces import layout as L
-from .propulsion import S_DADR, S_PROP
+from .propulsion import (GOVERNED, LOCKED, M_INTEG, M_PITCH, M_SETPOINT, M_TORQUE, MODE_NAMES, NMACH, S_CP,
+                         S_DADR, S_FRICTION, S_PITCH_DESIGN, S_PROP)
 from .sea import NENV, Current
 from .sea import pack as pack_env
 from .units import G, deg
@@ -47,6 +48,8 @@ class ShipState:
     roll: float = 0.0
     pitch: float = 0.0
     shaft_rps: tuple = ()
+    pitch_ratio: tuple = ()  # pitch ratio per shaft (controllable pitch; fixed pitch ignores it)
+    shaft_modes: tuple = ()  # "governed" (default), "trailed" or "locked" per shaft
     rudder: float = 0.0
     time: float = 0.0
 
@@ -123,7 +126,9 @@ class Simulator:
         self.env = np.ascontiguousarray(np.broadcast_to(envs, (self.n, NENV))).copy()
         self.rud_cmd = np.zeros((self.n, self.nr))
         self.shaft_cmd = np.zeros((self.n, self.ns))
-        self.gov = np.zeros((self.n, self.ns))
+        self.pitch_cmd = np.tile(self.shaftp[:, S_PITCH_DESIGN], (self.n, 1))
+        self.shaft_mode = np.zeros((self.n, self.ns))
+        self.mach = np.zeros((self.n, self.ns, NMACH))
         self.nav = np.zeros((self.n, DY.NNAV))
         self.phases, self.hs, self.events, self.ecount = H.new_arrays(self.n)
         self.ctx = np.zeros((self.n, L.NCTX))
@@ -168,21 +173,34 @@ class Simulator:
             q[int(self.steer[k, 3])] = s.rudder
             self.rud_cmd[ship, k] = s.rudder
         rps = tuple(s.shaft_rps) + (0.0,) * (self.ns - len(s.shaft_rps))
+        pitch = tuple(s.pitch_ratio) + tuple(self.shaftp[len(s.pitch_ratio):, S_PITCH_DESIGN])
+        modes = tuple(s.shaft_modes) + ("governed",) * (self.ns - len(s.shaft_modes))
         for k in range(self.ns):
-            v[int(self.shaftp[k, S_DADR])] = 2.0 * math.pi * rps[k]
-            self.shaft_cmd[ship, k] = rps[k]
+            mode = MODE_NAMES[modes[k]]
+            n = 0.0 if mode == LOCKED else rps[k]
+            v[int(self.shaftp[k, S_DADR])] = 2.0 * math.pi * n
+            self.shaft_cmd[ship, k] = n
+            self.shaft_mode[ship, k] = mode
+            self.pitch_cmd[ship, k] = pitch[k]
+            self.mach[ship, k] = 0.0
+            self.mach[ship, k, M_PITCH] = pitch[k] if self.shaftp[k, S_CP] > 0 else self.shaftp[k, S_PITCH_DESIGN]
+            self.mach[ship, k, M_SETPOINT] = n
         self.time[ship] = s.time
         self.nav[ship] = 0.0
         self.nav[ship, DY.NV_PSI_U] = s.heading
         self.hs[ship] = 0.0
         self.ecount[ship] = 0
         self.qfrc[ship] = 0.0
-        # governor integrators hold the propeller torque of this state (no start-up transient)
+        # governors hold the torque of this state (no start-up transient)
         self.evaluate()
         for k in range(self.ns):
+            if self.shaft_mode[ship, k] != GOVERNED:
+                continue
             kp = int(self.shaftp[k, S_PROP])
             nk = self.ctx[ship, L.SHAFT_N + kp]
-            self.gov[ship, k] = self.aux[ship, L.AUX_PROP + 8 * kp + L.P_TORQUE] + self.shaftp[k, 1] * nk
+            q = self.aux[ship, L.AUX_PROP + 8 * kp + L.P_TORQUE] + self.shaftp[k, S_FRICTION] * nk
+            self.mach[ship, k, M_INTEG] = q
+            self.mach[ship, k, M_TORQUE] = q
 
     def _current_world(self, ship: int, x: float, y: float, t: float) -> np.ndarray:
         from .sea import current_at
@@ -195,20 +213,21 @@ class Simulator:
         Fills ``ctx``, ``aux``, ``comp_w``, ``nudot`` and ``qfrc`` as a step would; returns ν̇ (N, 6).
         """
         nav = self.nav.copy()
-        gov = self.gov.copy()
+        mach = self.mach.copy()
         hs = self.hs.copy()
         ev = self.events.copy()
         ec = self.ecount.copy()
         rc = self.rud_cmd.copy()
-        self._call(nav=nav, gov=gov, hs=hs, events=ev, ecount=ec, rud_cmd=rc, krec=-1)
+        self._call(nav=nav, mach=mach, hs=hs, events=ev, ecount=ec, rud_cmd=rc, krec=-1)
         return self.nudot.copy()
 
-    def _call(self, nav=None, gov=None, hs=None, events=None, ecount=None, rud_cmd=None, krec=-1, rec=None):
+    def _call(self, nav=None, mach=None, hs=None, events=None, ecount=None, rud_cmd=None, krec=-1, rec=None):
         return self._kernel(self.dt, self.qpos, self.qvel, self.time, self.qfrc,
                               self.comp_kind, self.comp_off, self.comp_par, self.minv, self.mrb, self.ma,
                               self.munk_in_hull, self.rb, self.steer, self.shaftp, self.env,
-                              self.rud_cmd if rud_cmd is None else rud_cmd, self.shaft_cmd,
-                              self.gov if gov is None else gov, self.nav if nav is None else nav,
+                              self.rud_cmd if rud_cmd is None else rud_cmd, self.shaft_cmd, self.pitch_cmd,
+                              self.shaft_mode, self.mach if mach is None else mach,
+                              self.nav if nav is None else nav,
                               self.phases, self.hs if hs is None else hs,
                               self.events if events is None else events,
                               self.ecount if ecount is None else ecount,
@@ -292,36 +311,65 @@ class Simulator:
         self._krow = 0
 
     # ------------------------------------------------------------------ steady states
-    def self_propulsion(self, ship: int, speed: float, heading: float = 0.0, trim_iterations: int = 4) -> ShipState:
+    def _surge_residual(self, ship: int, s: ShipState) -> float:
+        """Net surge force of condition s (straight ahead, rudders amidships)."""
+        self.set_state(ship, s)
+        return float((self.mrb[ship] + self.ma[ship])[0] @ self.evaluate()[ship])
+
+    def _trim(self, ship: int, s: ShipState) -> ShipState:
+        """One Newton step on heave, heel and trim towards the static balance of condition s."""
+        if self.planar:
+            return s
+        self.set_state(ship, s)
+        F = (self.mrb[ship] + self.ma[ship]) @ self.evaluate()[ship]
+        dz, dphi, dth = np.linalg.solve(self.vessel.restoring_matrix()[2:5, 2:5], F[2:5])
+        s.z += dz
+        s.roll += dphi
+        s.pitch += dth
+        return s
+
+    def self_propulsion(self, ship: int, speed: float, heading: float = 0.0, pitch: tuple = (),
+                        trim_iterations: int = 4) -> ShipState:
         """The calm-water steady straight-ahead condition at ``speed`` through the water.
 
-        Finds the shaft speed at which the surge forces balance (all shafts equal, rudders
-        amidships) and the heave, heel and trim at which heave force, roll and pitch moments
-        balance; returns that condition (also placed on the ship).
+        Finds the shaft speed (all shafts equal, at the given or design pitch, rudders amidships) at
+        which the surge forces balance, and the heave, heel and trim at which the heave force, roll
+        and pitch moments balance; returns that condition (also placed on the ship).
         """
-        s = ShipState(heading=heading, u=speed, shaft_rps=(0.0,) * self.ns)
-        C = self.vessel.restoring_matrix()[2:5, 2:5]
+        s = ShipState(heading=heading, u=speed, shaft_rps=(0.0,) * self.ns, pitch_ratio=tuple(pitch))
         n_hi = float(np.max([sh.max_rps for sh in self.vessel.shafts]))
 
-        def surge_residual(n):
+        def resid(n):
             s.shaft_rps = (n,) * self.ns
-            self.set_state(ship, s)
-            return float((self.mrb[ship] + self.ma[ship])[0] @ self.evaluate()[ship])
+            return self._surge_residual(ship, s)
 
-        n_sp = 0.0
         for _ in range(trim_iterations):
-            if surge_residual(n_hi) < 0:
+            if resid(n_hi) < 0:
                 raise SimulationError(f"no shaft speed up to {n_hi * 60:.1f} r/min holds {speed:.3f} m/s")
-            n_sp = brentq(surge_residual, 1e-6, n_hi, xtol=1e-13, rtol=1e-14)
+            n_sp = brentq(resid, 1e-6, n_hi, xtol=1e-13, rtol=1e-14)
             s.shaft_rps = (n_sp,) * self.ns
+            s = self._trim(ship, s)
+        self.set_state(ship, s)
+        return s
+
+    def steady_at_order(self, ship: int, rps: tuple, pitch: tuple = (), heading: float = 0.0,
+                        trim_iterations: int = 4) -> ShipState:
+        """The calm-water steady straight-ahead speed at the given shaft speeds and pitch ratios
+        (dead in the water when they give no ahead thrust); returns that condition."""
+        s = ShipState(heading=heading, u=0.0, shaft_rps=tuple(rps), pitch_ratio=tuple(pitch))
+        if self._surge_residual(ship, s) <= 0.0:
             self.set_state(ship, s)
-            F = (self.mrb[ship] + self.ma[ship]) @ self.evaluate()[ship]
-            if self.planar:
-                break
-            dz, dphi, dth = np.linalg.solve(C, F[2:5])
-            s.z += dz
-            s.roll += dphi
-            s.pitch += dth
-        s.shaft_rps = (n_sp,) * self.ns
+            return s  # no ahead thrust: dead in the water
+        u_hi = 0.9 * float(self.limits[0])
+
+        def resid(u):
+            s.u = u
+            return self._surge_residual(ship, s)
+
+        if resid(u_hi) > 0:
+            raise SimulationError(f"the order {rps} gives more than {u_hi:.1f} m/s")
+        for _ in range(trim_iterations):
+            s.u = brentq(resid, 0.0, u_hi, xtol=1e-12, rtol=1e-14)
+            s = self._trim(ship, s)
         self.set_state(ship, s)
         return s

@@ -21,7 +21,7 @@ import numpy as np
 
 from . import propulsion
 from .errors import InputError
-from .forces import hull_mmg, hydrostatics, propeller_mmg, rudder_mmg
+from .forces import hull_mmg, hydrostatics, propeller, rudder_mmg
 from .schema import flag, load_toml, num, read_table, text, unknown_key
 from .units import DEG, G
 
@@ -98,7 +98,7 @@ class Autopilot:
 _SECTIONS = {"meta": Meta, "particulars": Particulars, "inertia": Inertia, "hydrostatics": Hydrostatics,
              "added_mass": AddedMass, "damping": Damping, "autopilot": Autopilot}
 _HULLS = {"mmg": ("hull_mmg", hull_mmg.HullMMG)}
-_ARRAYS = {"propeller": propeller_mmg.PropellerMMG, "shaft": propulsion.Shaft, "rudder": rudder_mmg.RudderMMG}
+_ARRAYS = {"propeller": propeller.Propeller, "shaft": propulsion.Shaft, "rudder": rudder_mmg.RudderMMG}
 
 
 @dataclasses.dataclass
@@ -333,7 +333,17 @@ def _assemble(toml_path: Path, meta: Meta, parts: dict, hull, arrays: dict, sour
         jid, qadr, dadr = hinge(f"shaft[{i}].joint", s.joint, [float(s.rotation), 0.0, 0.0])
         mismatch(f"joint {s.joint!r} armature (shaft[{i}].inertia)", model.dof_armature[dadr], s.inertia)
         k = pnames.index(s.propeller)
-        shaft_rows[k] = propulsion.pack(s, k, qadr, dadr)
+        pr = props[k]
+        if s.controllable_pitch:
+            if not (s.pitch_min < s.pitch_max and s.pitch_rate > 0):
+                raise InputError(f, f"shaft[{i}]", "a controllable-pitch shaft needs pitch_min < pitch_max and "
+                                                   "pitch_rate > 0")
+            if not (s.pitch_min <= pr.pitch_ratio <= s.pitch_max):
+                raise InputError(f, f"shaft[{i}].pitch_max", f"the design pitch ratio {pr.pitch_ratio} of propeller "
+                                                             f"{pr.name!r} is outside [pitch_min, pitch_max]")
+        if pr.curve == "polynomial" and pr.j_max <= 0:
+            raise InputError(f, f"propeller[{k}].j_max", "a polynomial curve needs j_max > 0 (its validity)")
+        shaft_rows[k] = propulsion.pack(s, k, qadr, dadr, pr.pitch_ratio)
     shaft_params = np.vstack(shaft_rows)
     rudder_adr = []
     steering = []
@@ -384,8 +394,8 @@ def _derive(v: Vessel) -> None:
     comps = [Component("hull", hull_mmg.KIND, hull_mmg.pack(v.hull, Lpp, d, rho, u_floor))]
     pnames = [p.name for p in v.propellers]
     for k, pr in enumerate(v.propellers):
-        comps.append(Component(f"propeller:{pr.name}", propeller_mmg.KIND,
-                               propeller_mmg.pack(pr, k, Lpp, rho, u_floor)))
+        comps.append(Component(f"propeller:{pr.name}", propeller.KIND,
+                               propeller.pack(pr, k, Lpp, rho, u_floor)))
     for k, rd in enumerate(v.rudders):
         kp = pnames.index(rd.propeller)
         comps.append(Component(f"rudder:{rd.name}", rudder_mmg.KIND,

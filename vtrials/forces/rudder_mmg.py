@@ -2,8 +2,9 @@
 
 Yasukawa & Yoshimura (2015) eqs. (18)–(26):
 u_R = ε u (1 − w_P) √(η{1 + κ[√(1 + 8K_T/(πJ²)) − 1]}² + (1 − η)), η = D_P/H_R, written here
-as ε √(η(u_P + κ(√(u_P² + 8K_T n²D_P²/π) − u_P))² + (1 − η)u_P²) with u_P = u(1 − w_P), which is
-the same for n > 0 and stays finite as J → 0; v_R = U γ_R β_R, β_R = β − l′_R r′;
+as ε √(η(u_P + κ(√(u_P² + 8T/(πρD_P²)) − u_P))² + (1 − η)u_P²) with u_P = u(1 − w_P) and T the
+thrust, which is the same for n > 0, stays finite as J → 0 and is defined in every quadrant (a
+negative jet term is cut at zero); v_R = U γ_R β_R, β_R = β − l′_R r′;
 α_R = δ − atan(v_R/u_R); F_N = ½ρA_R(u_R² + v_R²) f_α sin α_R;
 X_R = −(1 − t_R)F_N sin δ, Y_R = −(1 + a_H)F_N cos δ, N_R = −(x_R + a_H x_H)F_N cos δ.
 Sign: δ > 0 (trailing edge to starboard) gives N_R > 0, a turn to starboard.
@@ -76,11 +77,10 @@ def kernel(p, env, ctx, aux, w):
     beta = math.atan2(-v, u)
     delta = ctx[L.DELTA + k]
     b = L.AUX_PROP + 8 * kp
-    KT = aux[b + L.P_KT]
-    n = aux[b + L.P_N]
     uP = aux[b + L.P_UA]
     eta = D / HR
-    jet = uP * uP + 8.0 * KT * n * n * D * D / math.pi
+    # 8 K_T n² D²/π written with the thrust itself, 8T/(πρD²): valid in every quadrant
+    jet = uP * uP + 8.0 * aux[b + L.P_THRUST] / (math.pi * rho * D * D)
     if jet < 0.0:
         jet = 0.0
     slip = uP + p[17] * (math.sqrt(jet) - uP)
