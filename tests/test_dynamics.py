@@ -90,7 +90,7 @@ def test_ideal_fluid_invariants(vessel):
     """No hydrodynamic forces, no gravity, the Munk moments in: Kirchhoff's body conserves energy and
     world linear impulse. Symplectic Euler keeps the energy error small and bounded."""
     sim = Simulator(vessel, 1, 0.002, components=[], gravity=0.0, limits=(1e9, 4.0, 1e9))
-    sim.munk_in_hull = 0
+    sim.coriolis_mode = 2  # full Kirchhoff terms, Munk moments included
     sim.set_state(0, ShipState(u=1.0, v=0.3, r=0.2, roll=0.1, pitch=0.05))
     sim.qvel[0, 2] = 0.05
     sim.qvel[0, 3] = 0.1

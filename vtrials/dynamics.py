@@ -31,7 +31,7 @@ import numpy as np
 
 from . import helm as H
 from . import propulsion as PR
-from .forces import hull_mmg, hydrostatics, propeller, rudder_mmg
+from .forces import hull_blanke, hull_mmg, hydrostatics, propeller, rudder
 from .forces import layout as L
 from .sea import E_DEPTH, current_at
 
@@ -55,8 +55,10 @@ def dispatch(kind, p, env, ctx, aux, w):
         hull_mmg.kernel(p, env, ctx, aux, w)
     elif kind == propeller.KIND:
         propeller.kernel(p, env, ctx, aux, w)
-    elif kind == rudder_mmg.KIND:
-        rudder_mmg.kernel(p, env, ctx, aux, w)
+    elif kind == rudder.KIND:
+        rudder.kernel(p, env, ctx, aux, w)
+    elif kind == hull_blanke.KIND:
+        hull_blanke.kernel(p, env, ctx, aux, w)
     elif kind == hydrostatics.KIND_RESTORING:
         hydrostatics.restoring_kernel(p, env, ctx, aux, w)
     elif kind == hydrostatics.KIND_DAMPING:
@@ -139,7 +141,7 @@ def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[s
 
 
 def _step_forces(dt, qpos, qvel, time, qfrc,
-                 comp_kind, comp_off, comp_par, minv, mrb, ma, munk_in_hull, rb, steer, shaftp, env,
+                 comp_kind, comp_off, comp_par, minv, mrb, ma, coriolis_mode, rb, steer, shaftp, env,
                  rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events, ecount,
                  ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch):
     """Compute MuJoCo's applied generalized forces for every ship; see the module docstring.
@@ -299,7 +301,11 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
         for j in range(6):
             rhs[j] = tau[j] + grav[j]
         coriolis(mrb[i], nu1, om, True, crb)
-        coriolis(ma[i], nu1r, om, munk_in_hull == 0, cvec)
+        if coriolis_mode == 0:
+            for j in range(6):
+                cvec[j] = 0.0
+        else:
+            coriolis(ma[i], nu1r, om, coriolis_mode == 2, cvec)
         for j in range(6):
             rhs[j] -= crb[j] + cvec[j]
             rhs[j] += ma[i, j, 0] * ac0 + ma[i, j, 1] * ac1 + ma[i, j, 2] * ac2

@@ -42,6 +42,11 @@ class Spec:
     required: bool = True
 
     def allowed(self) -> str:
+        if self.kind == "vec":
+            lo = "-inf" if self.lo is None else f"{self.lo:g}"
+            hi = "inf" if self.hi is None else f"{self.hi:g}"
+            unit = f" {self.unit}" if self.unit else ""
+            return f"a list of numbers in [{lo}, {hi}]{unit}"
         if self.kind == "text":
             return "one of " + ", ".join(repr(c) for c in self.choices) if self.choices else "a string"
         if self.kind == "flag":
@@ -68,6 +73,12 @@ def num(doc: str = "", unit: str = "", lo: float | None = None, hi: float | None
         lo_open: bool = False, hi_open: bool = False, default: Any = dataclasses.MISSING) -> Any:
     """A real-valued field in [lo, hi] (open ends with lo_open/hi_open)."""
     return _field(Spec("num", doc, unit, lo, hi, lo_open, hi_open, required=default is dataclasses.MISSING), default)
+
+
+def vector(doc: str = "", unit: str = "", lo: float | None = None, hi: float | None = None, *,
+           default: Any = dataclasses.MISSING) -> Any:
+    """A list of real numbers, each in [lo, hi]."""
+    return _field(Spec("vec", doc, unit, lo, hi, required=default is dataclasses.MISSING), default)
 
 
 def integer(doc: str = "", lo: int | None = None, hi: int | None = None, *, default: Any = dataclasses.MISSING) -> Any:
@@ -137,6 +148,11 @@ def check_value(spec: Spec, value: Any, file: str, name: str) -> Any:
         if lo_bad or hi_bad:
             raise InputError(file, name, f"{value!r} is out of range: expected {spec.allowed()}")
         return value
+    if spec.kind == "vec":
+        if not isinstance(value, list) or not value:
+            raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
+        item = Spec("num", spec.doc, spec.unit, spec.lo, spec.hi)
+        return tuple(check_value(item, x, file, f"{name}[{k}]") for k, x in enumerate(value))
     if spec.kind == "text":
         if not isinstance(value, str):
             raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
@@ -177,7 +193,7 @@ def read_table(cls: type, table: Any, file: str, section: str, *, sourced: bool 
         name = _join(section, key)
         spec = spec_of(fields[key])
         value = raw
-        if sourced and spec.kind in ("num", "int"):
+        if sourced and spec.kind in ("num", "int", "vec"):
             if isinstance(raw, dict):
                 bad = set(raw) - {"value", "source", "unit", "note"}
                 if bad:

@@ -114,7 +114,7 @@ class Simulator:
         self.minv = np.tile(Minv, (self.n, 1, 1))
         self.mrb = np.tile(vessel.M_RB, (self.n, 1, 1))
         self.ma = np.tile(vessel.M_A, (self.n, 1, 1))
-        self.munk_in_hull = 1 if vessel.added_mass.munk_in_hull else 0
+        self.coriolis_mode = {"none": 0, "no_munk": 1, "kirchhoff": 2}[vessel.added_mass.coriolis]
         self.rb = np.tile(np.array([vessel.mass, *vessel.r_G, gravity]), (self.n, 1))
         self.steer = np.ascontiguousarray(vessel.steering)
         self.shaftp = np.ascontiguousarray(vessel.shaft_params)
@@ -224,7 +224,7 @@ class Simulator:
     def _call(self, nav=None, mach=None, hs=None, events=None, ecount=None, rud_cmd=None, krec=-1, rec=None):
         return self._kernel(self.dt, self.qpos, self.qvel, self.time, self.qfrc,
                               self.comp_kind, self.comp_off, self.comp_par, self.minv, self.mrb, self.ma,
-                              self.munk_in_hull, self.rb, self.steer, self.shaftp, self.env,
+                              self.coriolis_mode, self.rb, self.steer, self.shaftp, self.env,
                               self.rud_cmd if rud_cmd is None else rud_cmd, self.shaft_cmd, self.pitch_cmd,
                               self.shaft_mode, self.mach if mach is None else mach,
                               self.nav if nav is None else nav,

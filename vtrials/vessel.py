@@ -21,8 +21,8 @@ import numpy as np
 
 from . import propulsion
 from .errors import InputError
-from .forces import hull_mmg, hydrostatics, propeller, rudder_mmg
-from .schema import flag, load_toml, num, read_table, text, unknown_key
+from .forces import hull_blanke, hull_mmg, hydrostatics, propeller, rudder
+from .schema import load_toml, num, read_table, text, unknown_key, vector
 from .units import DEG, G
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -33,7 +33,15 @@ class Meta:
     name: str = text("model name (its folder name)")
     title: str = text("one-line description")
     mjcf: str = text("MJCF file in the model folder")
-    hull_model: str = text("hull force model", ("mmg",))
+    hull_model: str = text("hull force model", ("mmg", "blanke"))
+
+
+@dataclasses.dataclass(frozen=True)
+class Resistance:
+    """Calm-water resistance curve (for hull models that take it as a table)."""
+
+    speeds: tuple = vector("speeds through the water, increasing, from 0", "m/s", 0.0, 100.0)
+    values: tuple = vector("resistance at those speeds", "N", 0.0, 1e9)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,17 +72,35 @@ class Hydrostatics:
     KB: float = num("centre of buoyancy above keel", "m", 0.0, 40.0, lo_open=True)
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class AddedMass:
-    m_x_prime: float = num("surge added mass m'_x (÷ ½ρL²d)", "", 0.0, 1.0)
-    m_y_prime: float = num("sway added mass m'_y (÷ ½ρL²d)", "", 0.0, 2.0)
-    J_z_prime: float = num("yaw added inertia J'_z (÷ ½ρL⁴d), about midship", "", 0.0, 1.0)
+    """Added mass in one of two forms; heave and pitch always as ratios (no maneuvering model has them).
+
+    ``mmg``: non-dimensional m'_x, m'_y, J'_z at midship, roll as a ratio. ``derivatives``: the
+    dimensional acceleration derivatives of a 4-DOF model (sign convention: force = derivative ×
+    acceleration, so the added mass is minus the derivative).
+    """
+
+    form: str = text("how the added mass is given", ("mmg", "derivatives"))
+    m_x_prime: float = num("surge added mass m'_x (÷ ½ρL²d)", "", 0.0, 1.0, default=0.0)
+    m_y_prime: float = num("sway added mass m'_y (÷ ½ρL²d)", "", 0.0, 2.0, default=0.0)
+    J_z_prime: float = num("yaw added inertia J'_z (÷ ½ρL⁴d), about the origin", "", 0.0, 1.0, default=0.0)
+    roll_ratio: float = num("roll added inertia ÷ roll inertia about G (mmg form)", "", 0.0, 5.0, default=0.0)
+    X_udot: float = num("X_u̇", "kg", -1e12, 0.0, default=0.0)
+    Y_vdot: float = num("Y_v̇", "kg", -1e12, 0.0, default=0.0)
+    Y_pdot: float = num("Y_ṗ", "kg m", -1e12, 1e12, default=0.0)
+    Y_rdot: float = num("Y_ṙ", "kg m", -1e12, 1e12, default=0.0)
+    K_vdot: float = num("K_v̇", "kg m", -1e12, 1e12, default=0.0)
+    K_pdot: float = num("K_ṗ", "kg m^2", -1e14, 0.0, default=0.0)
+    K_rdot: float = num("K_ṙ", "kg m^2", -1e14, 1e14, default=0.0)
+    N_vdot: float = num("N_v̇", "kg m", -1e12, 1e12, default=0.0)
+    N_pdot: float = num("N_ṗ", "kg m^2", -1e14, 1e14, default=0.0)
+    N_rdot: float = num("N_ṙ", "kg m^2", -1e14, 0.0, default=0.0)
     heave_ratio: float = num("heave added mass ÷ ship mass", "", 0.0, 5.0)
-    roll_ratio: float = num("roll added inertia ÷ roll inertia about G", "", 0.0, 5.0)
     pitch_ratio: float = num("pitch added inertia ÷ pitch inertia about G", "", 0.0, 5.0)
-    munk_in_hull: bool = flag("the hull derivatives already contain the ideal-fluid (Munk) moments, "
-                              "as captive-test derivatives do: leave ν×(A ν) out of the added-mass "
-                              "Coriolis terms")
+    coriolis: str = text("added-mass Coriolis terms in the dynamics: 'kirchhoff' (all), 'no_munk' (the hull "
+                         "derivatives contain the ideal-fluid Munk moments, as MMG's do) or 'none' (the "
+                         "derivatives contain all of them)", ("kirchhoff", "no_munk", "none"))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -97,8 +123,8 @@ class Autopilot:
 
 _SECTIONS = {"meta": Meta, "particulars": Particulars, "inertia": Inertia, "hydrostatics": Hydrostatics,
              "added_mass": AddedMass, "damping": Damping, "autopilot": Autopilot}
-_HULLS = {"mmg": ("hull_mmg", hull_mmg.HullMMG)}
-_ARRAYS = {"propeller": propeller.Propeller, "shaft": propulsion.Shaft, "rudder": rudder_mmg.RudderMMG}
+_HULLS = {"mmg": ("hull_mmg", hull_mmg.HullMMG), "blanke": ("hull_blanke", hull_blanke.HullBlanke)}
+_ARRAYS = {"propeller": propeller.Propeller, "shaft": propulsion.Shaft, "rudder": rudder.Rudder}
 
 
 @dataclasses.dataclass
@@ -126,6 +152,7 @@ class Vessel:
     damping: Damping
     autopilot: Autopilot
     hull: object
+    resistance: object
     propellers: list
     shafts: list
     rudders: list
@@ -191,7 +218,7 @@ def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
                              f"unknown ship {str(name_or_path)!r} (available: {', '.join(available_models())})")
     f = str(toml_path)
     doc = load_toml(toml_path)
-    known = list(_SECTIONS) + [v[0] for v in _HULLS.values()] + list(_ARRAYS)
+    known = list(_SECTIONS) + [v[0] for v in _HULLS.values()] + list(_ARRAYS) + ["resistance"]
     for key in doc:
         if key not in known:
             raise unknown_key(f, "", key, known)
@@ -202,10 +229,32 @@ def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
             raise InputError(f, sec, "missing section")
         parts[sec], sources[sec] = read_table(cls, doc[sec], f, sec, sourced=(sec != "meta"))
     meta: Meta = parts["meta"]
+    am: AddedMass = parts["added_mass"]
+    mmg_fields = ("m_x_prime", "m_y_prime", "J_z_prime", "roll_ratio")
+    der_fields = ("X_udot", "Y_vdot", "Y_pdot", "Y_rdot", "K_vdot", "K_pdot", "K_rdot", "N_vdot", "N_pdot", "N_rdot")
+    wrong = [k for k in (der_fields if am.form == "mmg" else mmg_fields) if k in doc["added_mass"]]
+    if wrong:
+        raise InputError(f, f"added_mass.{wrong[0]}", f"not used with added_mass.form = {am.form!r}")
     hull_sec, hull_cls = _HULLS[meta.hull_model]
     if hull_sec not in doc:
         raise InputError(f, hull_sec, f"missing section (meta.hull_model is {meta.hull_model!r})")
     hull, sources[hull_sec] = read_table(hull_cls, doc[hull_sec], f, hull_sec, sourced=True)
+    for other, _ in _HULLS.values():
+        if other != hull_sec and other in doc:
+            raise InputError(f, other, f"section for another hull model (meta.hull_model is {meta.hull_model!r})")
+    resistance = None
+    if meta.hull_model == "blanke":
+        if "resistance" not in doc:
+            raise InputError(f, "resistance", "missing section (the blanke hull takes its resistance curve from it)")
+        resistance, sources["resistance"] = read_table(Resistance, doc["resistance"], f, "resistance", sourced=True)
+        sp, rv = np.array(resistance.speeds), np.array(resistance.values)
+        if len(sp) != len(rv) or len(sp) < 2:
+            raise InputError(f, "resistance.values", "needs as many values as speeds (at least 2)")
+        if sp[0] != 0.0 or rv[0] != 0.0 or np.any(np.diff(sp) <= 0):
+            raise InputError(f, "resistance.speeds", "must start at 0 m/s (with 0 N) and increase")
+    elif "resistance" in doc:
+        raise InputError(f, "resistance", "only the blanke hull model takes a resistance table")
+    parts["resistance"] = resistance
     arrays: dict[str, list] = {}
     for sec, cls in _ARRAYS.items():
         items = doc.get(sec, [])
@@ -358,7 +407,7 @@ def _assemble(toml_path: Path, meta: Meta, parts: dict, hull, arrays: dict, sour
             raise InputError(mf, f"joint of rudder[{i}]", "needs a positive armature (rudder stock inertia)")
     v = Vessel(name=meta.name, folder=folder, toml_path=toml_path, mjcf_path=mjcf_path, meta=meta,
                particulars=P, inertia=I, hydrostatics=H, added_mass=A, damping=D,
-               autopilot=parts["autopilot"], hull=hull,
+               autopilot=parts["autopilot"], hull=hull, resistance=parts["resistance"],
                propellers=props, shafts=shafts, rudders=rudders, sources=sources, model=model, sites=sites)
     v.mass = mass
     v.r_G = r_G
@@ -381,8 +430,17 @@ def _derive(v: Vessel) -> None:
     rho, Lpp, d = P.water_density, P.length, P.draught
     half = 0.5 * rho * Lpp ** 2 * d
     I_G = v.mass * np.array([I.k_xx ** 2, I.k_yy ** 2, I.k_zz ** 2])
-    M_A = np.diag([A.m_x_prime * half, A.m_y_prime * half, A.heave_ratio * v.mass,
-                   A.roll_ratio * I_G[0], A.pitch_ratio * I_G[1], A.J_z_prime * half * Lpp ** 2])
+    if A.form == "mmg":
+        M_A = np.diag([A.m_x_prime * half, A.m_y_prime * half, A.heave_ratio * v.mass,
+                       A.roll_ratio * I_G[0], A.pitch_ratio * I_G[1], A.J_z_prime * half * Lpp ** 2])
+    else:
+        M_A = np.zeros((6, 6))
+        M_A[0, 0] = -A.X_udot
+        M_A[2, 2] = A.heave_ratio * v.mass
+        M_A[4, 4] = A.pitch_ratio * I_G[1]
+        for row, (a, b, c) in ((1, (A.Y_vdot, A.Y_pdot, A.Y_rdot)), (3, (A.K_vdot, A.K_pdot, A.K_rdot)),
+                               (5, (A.N_vdot, A.N_pdot, A.N_rdot))):
+            M_A[row, 1], M_A[row, 3], M_A[row, 5] = -a, -b, -c
     v.M_A = M_A
     C = v.restoring_matrix()
     Mtot = v.M_RB + M_A
@@ -391,15 +449,19 @@ def _derive(v: Vessel) -> None:
         B[j] = 2.0 * zeta * math.sqrt(Mtot[dof, dof] * C[dof, dof])
     v.B_lin = B
     u_floor = 1e-3 * math.sqrt(G * Lpp)
-    comps = [Component("hull", hull_mmg.KIND, hull_mmg.pack(v.hull, Lpp, d, rho, u_floor))]
+    if v.meta.hull_model == "mmg":
+        comps = [Component("hull", hull_mmg.KIND, hull_mmg.pack(v.hull, Lpp, d, rho, u_floor))]
+    else:
+        comps = [Component("hull", hull_blanke.KIND,
+                           hull_blanke.pack(v.hull, np.array(v.resistance.speeds), np.array(v.resistance.values)))]
     pnames = [p.name for p in v.propellers]
     for k, pr in enumerate(v.propellers):
         comps.append(Component(f"propeller:{pr.name}", propeller.KIND,
                                propeller.pack(pr, k, Lpp, rho, u_floor)))
     for k, rd in enumerate(v.rudders):
         kp = pnames.index(rd.propeller)
-        comps.append(Component(f"rudder:{rd.name}", rudder_mmg.KIND,
-                               rudder_mmg.pack(rd, k, kp, v.propellers[kp].diameter, Lpp, rho, u_floor,
+        comps.append(Component(f"rudder:{rd.name}", rudder.KIND,
+                               rudder.pack(rd, k, kp, v.propellers[kp].diameter, Lpp, rho, u_floor,
                                                v.hull.z_H)))
     comps.append(Component("hydrostatics", hydrostatics.KIND_RESTORING,
                            hydrostatics.pack_restoring(v.mass, G, rho, P.displacement, H.waterplane_area, H.x_F,
