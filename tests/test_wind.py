@@ -15,13 +15,16 @@ References used by the checks (independent of the module's own code paths):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
+import numba as nb
 import numpy as np
 import pytest
 from scipy import integrate, signal
 from scipy.special import gamma as G
 
+from vtrials import sea
 from vtrials import wind as W
 from vtrials.forces import layout as L
 
@@ -105,8 +108,9 @@ def test_npd_units_against_published_turbulence_intensity():
 def test_spectrum_asymptotes():
     U0, z = 15.0, 10.0
     # low-frequency limit of NPD: S(0) = 320 (U0/10)² (z/10)^0.45
-    assert W.npd_spectrum(1e-9, U0, z) == pytest.approx(320.0 * 1.5 ** 2, rel=1e-6)
-    assert W.npd_spectrum(1e-9, U0, 40.0) == pytest.approx(320.0 * 1.5 ** 2 * 4.0 ** 0.45, rel=1e-6)
+    # (approached slowly: 1 − S/S(0) ≈ (5/3)(f̃)^0.468, still 2e-3 at f = 1e-9 Hz)
+    assert W.npd_spectrum(0.0, U0, z) == pytest.approx(320.0 * 1.5 ** 2, rel=1e-14)
+    assert W.npd_spectrum(1e-15, U0, 40.0) == pytest.approx(320.0 * 1.5 ** 2 * 4.0 ** 0.45, rel=1e-5)
     # Harris: S(0) = 4κLU/2^(5/6)
     assert W.harris_spectrum(0.0, U0) == pytest.approx(4 * 0.0025 * 1800 * U0 / 2 ** (5 / 6), rel=1e-14)
 
@@ -120,7 +124,7 @@ def test_spectrum_asymptotes():
     # Davenport rises as f at the low end, Harris and NPD are flat there
     assert slope(lambda f: W.davenport_spectrum(f, U0), 1e-6) == pytest.approx(1.0, rel=1e-4)
     assert abs(slope(lambda f: W.harris_spectrum(f, U0), 1e-7)) < 1e-6
-    assert abs(slope(lambda f: W.npd_spectrum(f, U0, z), 1e-9)) < 1e-3
+    assert abs(slope(lambda f: W.npd_spectrum(f, U0, z), 1e-15)) < 1e-5
     # NPD at 0.01–1 Hz (what a ship feels) is already steep: between −1.2 and −5/3
     s = slope(lambda f: W.npd_spectrum(f, U0, z), 0.1)
     assert -5 / 3 < s < -1.2
@@ -174,8 +178,10 @@ def test_realization_variance(realization):
 
 def test_realization_welch_psd_matches_spectrum(realization):
     name, amp, om, ph, t, u, S = realization
+    # 8192-sample Hann segments (Δf = 2.4e-4 Hz, ~9 averages); 10 log bands over 0.005–0.5 Hz.
+    # Over 12 seeds the worst band was off by 3–15 %, the variance by −1.4…+2.1 standard errors.
     f, P = signal.welch(u, fs=FS, nperseg=8192, window="hann", detrend="constant")
-    bands = np.geomspace(3e-3, 0.3, 11)
+    bands = np.geomspace(5e-3, 0.5, 11)
     ratios = []
     for lo, hi in zip(bands[:-1], bands[1:]):
         sel = (f >= lo) & (f < hi)
@@ -237,8 +243,8 @@ def test_mirror_symmetry():
 def test_yaw_moment_follows_the_area_centroid():
     """Beam wind: bow pushed to leeward if the lateral centroid is forward of mid-length, and
     to windward if it is aft (Isherwood's 90° row balances at C/L = 0.2627/0.508 ≈ 0.52)."""
-    fwd = W.Windage(**{**VLCC.__dict__, "C": 0.35 * VLCC.L_oa})
-    aft = W.Windage(**{**VLCC.__dict__, "C": 0.65 * VLCC.L_oa})
+    fwd = dataclasses.replace(VLCC, C=0.35 * VLCC.L_oa)
+    aft = dataclasses.replace(VLCC, C=0.65 * VLCC.L_oa)
     assert W.wind_loads(15.0, 90 * DEG, fwd)[5] < 0  # wind from starboard, bow to port (leeward)
     assert W.wind_loads(15.0, 90 * DEG, aft)[5] > 0  # bow to starboard (into the wind)
     # bow-quarter wind puts the centre of pressure forward, quarter wind aft
@@ -379,8 +385,11 @@ def test_kernel_calm_air_ship_speed_and_beam_wind():
 def test_kernel_gusts_from_env():
     rng = np.random.default_rng(5)
     gusts = W.gust_components("npd", 12.0, 10.0, rng, n_components=64)
-    env = W.pack_wind_env(np.zeros(64), 12.0, 0.0, gusts=gusts)
+    base = sea.pack(sea.Current(speed_kn=1.5, direction_deg=30.0, tidal_amplitude_kn=0.5), 60.0)
+    env = W.pack_wind_env(base, 12.0, 0.0, gusts=gusts)
     assert env.shape[0] == W.env_width(64) and env[W.E_WIND_NG] == 64
+    np.testing.assert_array_equal(env[:16], base[:16])  # the current and the depth are untouched
+    assert not np.any(env[21:64])  # the rest of the wind header and the wave header stay free
     p = W.pack_wind(VLCC)
     for t in (0.0, 17.3, 900.0):
         _, ctx = _run_kernel(p, env, 0.0, 0.0, 0.0, np.eye(3), t)
@@ -398,3 +407,40 @@ def test_scenario_wind_packs_in_si():
     assert e1[W.E_WIND_NG] == 32 and e1.shape[0] == W.E_GUST + 96
     with pytest.raises(ValueError):
         W.pack_env(wind, np.zeros(64))  # gusts need a Generator
+
+
+def test_kernel_is_allocation_free():
+    """Called from compiled code (as the dynamics kernel does), the wind kernel allocates nothing:
+    numba's allocation count of a driver loop does not grow with the number of calls."""
+    try:
+        from numba.core.runtime import _nrt_python as nrt
+        from numba.core.runtime import rtsys
+    except ImportError:  # pragma: no cover - numba internals moved
+        pytest.skip("numba NRT statistics not available")
+
+    @nb.njit
+    def drive(n, p, env, ctx, aux, w):
+        s = 0.0
+        for i in range(n):
+            ctx[L.TIME] = 0.1 * i
+            W.wind_kernel(p, env, ctx, aux, w)
+            s += w[0]
+        return s
+
+    p = W.pack_wind(VLCC)
+    env = W.pack_wind_env(np.zeros(64), 12.0, 0.3,
+                          gusts=W.gust_components("npd", 12.0, 10.0, np.random.default_rng(1), 64))
+    ctx = np.zeros(L.NCTX)
+    ctx[L.ROT:L.ROT + 9] = np.eye(3).ravel()
+    args = (p, env, ctx, np.zeros(L.NAUX), np.zeros(6))
+    drive(1, *args)
+    nrt.memsys_enable_stats()
+    try:
+        a = rtsys.get_allocation_stats().alloc
+        drive(1, *args)
+        b = rtsys.get_allocation_stats().alloc
+        drive(2000, *args)
+        c = rtsys.get_allocation_stats().alloc
+    finally:
+        nrt.memsys_disable_stats()
+    assert c - b == b - a  # only the fixed cost of entering compiled code from Python

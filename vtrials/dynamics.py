@@ -31,6 +31,7 @@ import numpy as np
 
 from . import helm as H
 from . import propulsion as PR
+from . import wind
 from .forces import hull_blanke, hull_mmg, hydrostatics, propeller, rudder
 from .forces import layout as L
 from .sea import E_DEPTH, current_at
@@ -59,6 +60,8 @@ def dispatch(kind, p, env, ctx, aux, w):
         rudder.kernel(p, env, ctx, aux, w)
     elif kind == hull_blanke.KIND:
         hull_blanke.kernel(p, env, ctx, aux, w)
+    elif kind == wind.KIND:
+        wind.wind_kernel(p, env, ctx, aux, w)
     elif kind == hydrostatics.KIND_RESTORING:
         hydrostatics.restoring_kernel(p, env, ctx, aux, w)
     elif kind == hydrostatics.KIND_DAMPING:

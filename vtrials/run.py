@@ -26,10 +26,12 @@ from .errors import InputError
 from .maneuvers import Progress
 from .records import atomic_path, write_groups
 from .scenario import Scenario, load_scenario
+from .forces import layout as L
 from .sea import pack as pack_env
-from .simulator import Simulator
+from .simulator import ShipState, Simulator
+from .wind import pack_env as pack_wind
 from .truth import describe, ship_columns
-from .units import DEG, speed_to_froude
+from .units import DEG, KNOT, speed_to_froude
 
 
 @dataclasses.dataclass
@@ -80,31 +82,62 @@ def _autopilot_args(scn: Scenario) -> tuple:
             kp * ap.derivative_time)
 
 
+def _approach(sim: Simulator, i: int, scn: Scenario, m) -> ShipState:
+    """The steady condition ship i starts its approach in (also placed on it)."""
+    v = scn.vessel
+    order = m.approach_order or (scn.initial.engine_order if m.approach_speed_kn is None else None)
+    if order is not None:
+        rps, pitch = v.telegraph[order]
+        pitches = (pitch,) * sim.ns if pitch is not None else ()
+        s = sim.steady_at_order(i, (rps,) * sim.ns, pitches, heading=scn.heading)
+    else:
+        U = m.approach_speed_kn * KNOT if m.approach_speed_kn is not None else scn.speed
+        s = sim.self_propulsion(i, U, scn.heading)
+    modes = ["governed"] * sim.ns
+    names = [sh.name for sh in v.shafts]
+    if m.trailed_shaft is not None:
+        modes[names.index(m.trailed_shaft)] = "trailed"
+    if m.locked_shaft is not None:
+        modes[names.index(m.locked_shaft)] = "locked"
+    if any(mm != "governed" for mm in modes):
+        s = dataclasses.replace(s, shaft_modes=tuple(modes))
+        sim.set_state(i, s)
+    return s
+
+
+def _environment(scn: Scenario) -> np.ndarray:
+    """The sea (current, wind with its gusts drawn from the scenario seed) as an environment block."""
+    env = pack_env(scn.current, scn.environment.water_depth_m)
+    gust_seed, = np.random.SeedSequence(scn.head.seed).spawn(1)
+    return pack_wind(scn.wind, env, np.random.default_rng(gust_seed))
+
+
 def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
     """Run every maneuver of the scenario side by side (one ship each) and compute truth metrics."""
     t_wall = time.perf_counter()
     vessel = scn.vessel
     N = len(scn.maneuvers)
     dt = scn.head.timestep_s
-    env = pack_env(scn.current, scn.environment.water_depth_m)
-    sim = Simulator(vessel, N, dt, env, nthread=nthread, record_every=scn.head.record_every,
+    sim = Simulator(vessel, N, dt, _environment(scn), nthread=nthread, record_every=scn.head.record_every,
                     planar=scn.head.planar)
-    U = scn.speed
-    s0 = sim.self_propulsion(0, U, scn.heading)
     ap = _autopilot_args(scn)
-    L_over_U = vessel.length / U
-    execute_step = []
-    for i, m in enumerate(scn.maneuvers):
-        sim.set_state(i, s0)
+    starts = [_approach(sim, i, scn, m) for i, m in enumerate(scn.maneuvers)]
+    for i in range(N):  # every ship placed last, so no steady-state search disturbs another
+        sim.set_state(i, starts[i])
         sim.set_helm(i, [(H.HEADING, scn.heading, *ap)])
+    U_ref = max([abs(s.u) for s in starts] + [0.1 * math.sqrt(9.80665 * vessel.length)])
+    L_over_U = vessel.length / U_ref
+    execute_step = []
+    for m in scn.maneuvers:
         approach = m.approach_s if m.approach_s is not None else 3.0 * L_over_U
         execute_step.append(int(round(approach / dt)))
-    max_dur = [getattr(m, "max_duration_s", None) or 60.0 * L_over_U for m in scn.maneuvers]
+    max_dur = [m.max_duration_s or 60.0 * L_over_U for m in scn.maneuvers]
     t_exec = [math.nan] * N
     psi_exec = [0.0] * N
     t_finex = [math.nan] * N
     completed = [False] * N
     supervise = max(1, int(round(0.5 / dt)))  # the crew looks every half second
+    history: list[list[tuple[float, float]]] = [[] for _ in range(N)]
     step = 0
     running = set(range(N))
     while running:
@@ -114,23 +147,34 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
             sim.step(n)
             step += n
         for i in sorted(running):
+            t_i = float(sim.time[i])
             if math.isnan(t_exec[i]):
                 if step >= execute_step[i]:
-                    t_exec[i] = float(sim.time[i])
+                    t_exec[i] = t_i
                     psi_exec[i] = float(sim.nav[i, 0])
-                    sim.set_helm(i, scn.maneuvers[i].program(psi_exec[i], ap))
+                    ex = scn.maneuvers[i].execute(psi_exec[i], ap)
+                    sim.set_helm(i, ex.helm)
+                    if ex.order is not None:
+                        sim.set_order(i, *vessel.telegraph[ex.order])
                 continue
-            elapsed = float(sim.time[i]) - t_exec[i]
+            speed = float(np.hypot(sim.ctx[i, L.NU_R], sim.ctx[i, L.NU_R + 1]))
+            hist = history[i]
+            hist.append((t_i, speed))
+            while hist and hist[0][0] < t_i - 20.0:
+                hist.pop(0)
+            rate = (hist[-1][1] - hist[0][1]) / (hist[-1][0] - hist[0][0]) if hist[-1][0] - hist[0][0] >= 19.0 \
+                else math.inf
             phase = sim.helm_phase(i)
             tstart = sim.hs[i, H.H_TSTART]
-            pe = float(sim.time[i]) - tstart if tstart >= 0 else 0.0
-            prog = Progress(elapsed, float(sim.nav[i, 0]) - psi_exec[i], phase, pe, 10.0 * L_over_U)
+            pe = t_i - tstart if tstart >= 0 else 0.0
+            prog = Progress(t_i - t_exec[i], float(sim.nav[i, 0]) - psi_exec[i], phase, pe, 10.0 * L_over_U,
+                            surge=float(sim.ctx[i, L.NU_R]), speed_rate=rate)
             if scn.maneuvers[i].finished(prog):
-                t_finex[i] = float(sim.time[i])
+                t_finex[i] = t_i
                 completed[i] = True
                 running.discard(i)
-            elif elapsed >= max_dur[i]:
-                t_finex[i] = float(sim.time[i])
+            elif t_i - t_exec[i] >= max_dur[i]:
+                t_finex[i] = t_i
                 running.discard(i)
         if progress:
             progress(float(sim.time[0]), len(running))
@@ -147,7 +191,9 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
         if not completed[i]:
             metrics["incomplete"] = f"FINEX condition not reached within {max_dur[i]:.0f} s after EXECUTE"
         runs.append(ManeuverRun(m.name, m.kind, t_exec[i], t_finex[i], completed[i], metrics, cols))
-    initial = {"speed_mps": U, "froude_number": speed_to_froude(U, vessel.length),
+    s0 = starts[0]
+    U0 = abs(s0.u)
+    initial = {"speed_mps": U0, "froude_number": speed_to_froude(U0, vessel.length),
                "heading_deg": scn.initial.heading_deg, "shaft_rps": list(s0.shaft_rps),
                "shaft_rpm": [60.0 * n for n in s0.shaft_rps], "sinkage_m": s0.z,
                "heel_deg": math.degrees(s0.roll), "trim_deg": math.degrees(s0.pitch)}

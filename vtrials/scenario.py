@@ -20,7 +20,8 @@ import math
 from pathlib import Path
 
 from .errors import InputError
-from .maneuvers import KINDS
+from .maneuvers import KINDS, ORDER_CHOICES
+from .wind import Wind
 from .schema import flag, integer, load_toml, num, read_table, text, unknown_key
 from .sea import Current
 from .units import DEG, KNOT, froude_to_speed
@@ -42,9 +43,11 @@ class Initial:
     froude_number: float = num("approach speed as a length Froude number", "", 0.0, 1.0, lo_open=True, default=None)
     speed_kn: float = num("approach speed through the water", "kn", 0.0, 60.0, lo_open=True, default=None)
     speed_mps: float = num("approach speed through the water", "m/s", 0.0, 30.0, lo_open=True, default=None)
+    engine_order: str = text("instead of a speed: the steady speed of this engine order (\"stop\": dead in "
+                             "the water)", ORDER_CHOICES, default=None)
     heading_deg: float = num("approach heading (from north, clockwise)", "deg", -360.0, 360.0, default=0.0)
-    propulsion: str = text("how the shafts are set: the r/min that holds the speed in calm water",
-                           ("self_propelled",), default="self_propelled")
+    propulsion: str = text("how the shafts are set for a given speed: the r/min that holds it in calm water "
+                           "(at the design pitch)", ("self_propelled",), default="self_propelled")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,13 +63,16 @@ class Scenario:
     initial: Initial
     environment: Environment
     current: Current
+    wind: Wind
     maneuvers: list
     vessel: Vessel
 
     @property
     def speed(self) -> float:
-        """Approach speed through the water [m/s]."""
+        """Approach speed through the water [m/s] (None when the approach is an engine order)."""
         i = self.initial
+        if i.engine_order is not None:
+            return None
         if i.froude_number is not None:
             return froude_to_speed(i.froude_number, self.vessel.length)
         if i.speed_kn is not None:
@@ -97,17 +103,23 @@ def load_scenario(path: str | Path) -> Scenario:
         ship = str((p.parent / ship).resolve())
     vessel = load_vessel(ship, file_for_errors=f, field_for_errors="scenario.ship")
     init, _ = read_table(Initial, doc.get("initial", {}), f, "initial")
-    given = [k for k in ("froude_number", "speed_kn", "speed_mps") if getattr(init, k) is not None]
+    given = [k for k in ("froude_number", "speed_kn", "speed_mps", "engine_order") if getattr(init, k) is not None]
     if len(given) != 1:
-        raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps"
+        raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps, engine_order"
                          + (f" (got {', '.join(given)})" if given else ""))
     env_tab = dict(doc.get("environment", {}))
+    if not isinstance(env_tab, dict):
+        raise InputError(f, "environment", "expected a table")
     cur_tab = env_tab.pop("current", {})
+    wind_tab = env_tab.pop("wind", {})
     env, _ = read_table(Environment, env_tab, f, "environment")
     if env.water_depth_m <= vessel.particulars.draught:
         raise InputError(f, "environment.water_depth_m", f"{env.water_depth_m} m does not float the ship "
                                                          f"(draught {vessel.particulars.draught} m)")
     current, _ = read_table(Current, cur_tab, f, "environment.current")
+    wind, _ = read_table(Wind, wind_tab, f, "environment.wind")
+    if wind.speed_kn > 0 and vessel.windage is None:
+        raise InputError(f, "environment.wind.speed_kn", f"{vessel.name} has no [windage] data for wind loads")
     items = doc.get("maneuver")
     if not isinstance(items, list) or not items:
         raise InputError(f, "maneuver", "expected at least one [[maneuver]] table")
@@ -129,9 +141,21 @@ def load_scenario(path: str | Path) -> Scenario:
             if abs(value) > max_rudder + 1e-9:
                 raise InputError(f, f"{sec}.{field}", f"{value:g}° is beyond the maximum rudder angle of "
                                                       f"{vessel.name} ({max_rudder:g}°)")
+        if m.approach_order is not None and m.approach_speed_kn is not None:
+            raise InputError(f, f"{sec}.approach_order", "give approach_order or approach_speed_kn, not both")
+        shaft_names = [sh.name for sh in vessel.shafts]
+        for field in ("trailed_shaft", "locked_shaft"):
+            val = getattr(m, field)
+            if val is not None and val not in shaft_names:
+                raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r} (shafts of {vessel.name}: "
+                                                      f"{', '.join(shaft_names)})")
+        if m.trailed_shaft is not None and m.trailed_shaft == m.locked_shaft:
+            raise InputError(f, f"{sec}.locked_shaft", "a shaft cannot be trailed and locked at once")
+        if m.trailed_shaft is not None and m.locked_shaft is not None and len(shaft_names) == 2:
+            raise InputError(f, f"{sec}.locked_shaft", "no shaft would be left driving")
         maneuvers.append(m)
-    scn = Scenario(p, head, init, env, current, maneuvers, vessel)
-    if scn.speed > 0.9 * _runaway_speed(vessel):
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel)
+    if init.engine_order is None and scn.speed > 0.9 * _runaway_speed(vessel):
         raise InputError(f, "initial", f"approach speed {scn.speed:.2f} m/s is beyond this hull model's range")
     return scn
 

@@ -123,7 +123,9 @@ class Simulator:
         if envs is None:
             envs = pack_env(Current(), 1e4)
         envs = np.asarray(envs, dtype=np.float64)
-        self.env = np.ascontiguousarray(np.broadcast_to(envs, (self.n, NENV))).copy()
+        if envs.shape[-1] < NENV:
+            raise ValueError(f"environment blocks need at least {NENV} entries")
+        self.env = np.ascontiguousarray(np.broadcast_to(envs, (self.n, envs.shape[-1]))).copy()
         self.rud_cmd = np.zeros((self.n, self.nr))
         self.shaft_cmd = np.zeros((self.n, self.ns))
         self.pitch_cmd = np.tile(self.shaftp[:, S_PITCH_DESIGN], (self.n, 1))
@@ -246,6 +248,13 @@ class Simulator:
         self.hs[ship, H.H_NPHASE] = len(phases)
         self.hs[ship, H.H_TSTART] = -1.0
         self.hs[ship, H.H_ACTIVE] = 1.0 if phases else 0.0
+
+    def set_order(self, ship: int, rps: float, pitch: float | None = None) -> None:
+        """An engine order on every governed shaft: shaft speed [rev/s] and pitch ratio (CP only)."""
+        for k in range(self.ns):
+            self.shaft_cmd[ship, k] = rps
+            if pitch is not None:
+                self.pitch_cmd[ship, k] = pitch
 
     def helm_phase(self, ship: int) -> int:
         return int(self.hs[ship, H.H_PHASE])

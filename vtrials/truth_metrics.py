@@ -136,3 +136,73 @@ def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int
     if c3 is not None:
         out["period_s"] = c3[0] - c1[0]
     return out
+
+
+def _axes(x_w, y_w, heading):
+    psi0 = heading[0]
+    c, s = math.cos(psi0), math.sin(psi0)
+    ex, ey = x_w - x_w[0], y_w - y_w[0]
+    return ex * c + ey * s, -ex * s + ey * c
+
+
+def stopping(t, x_w, y_w, heading, u_r) -> dict:
+    """Stopping metrics from EXECUTE (index 0) on the water track (IMO MSC.137(76) / MSC/Circ.1053).
+
+    Dead in the water: the first instant the surge speed through the water reaches zero.
+    track_reach_m: distance sailed along the water track until then; head_reach_m: along the
+    approach heading; lateral_deviation_m: across it (+ to starboard).
+    """
+    t = np.asarray(t, float)
+    along, cross = _axes(x_w, y_w, heading)
+    path = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x_w), np.diff(y_w)))])
+    out: dict = {"approach_speed_mps": float(u_r[0])}
+    c = _first_crossing(t, -np.asarray(u_r), 0.0)
+    if c is None:
+        out["not_stopped"] = True
+        return out
+    td = c[0]
+    out["time_to_dead_in_water_s"] = td - t[0]
+    out["track_reach_m"] = _interp(t, path, td)
+    out["head_reach_m"] = _interp(t, along, td)
+    out["lateral_deviation_m"] = _interp(t, cross, td)
+    out["heading_change_deg"] = math.degrees(_interp(t, heading, td) - heading[0])
+    return out
+
+
+def speed_change(t, x_w, y_w, heading, u_r, v_r, *, settle_fraction: float = 0.02) -> dict:
+    """Acceleration / deceleration metrics from EXECUTE (index 0).
+
+    Terminal speed: mean speed through the water over the last 10 % of the run (at least the last
+    5 s). time_to_terminal_speed_s: from EXECUTE until the speed enters, for good, the band
+    ±settle_fraction × |terminal − initial| around the terminal speed; reach_m: distance along the
+    approach heading by then (track_distance_m along the water track).
+    """
+    t = np.asarray(t, float)
+    U = np.sign(u_r) * np.hypot(u_r, v_r)
+    along, _ = _axes(x_w, y_w, heading)
+    path = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x_w), np.diff(y_w)))])
+    n_last_5s = len(t) - int(np.searchsorted(t, t[-1] - 5.0))
+    n_tail = max(int(0.1 * len(t)), n_last_5s, 2)
+    UT = float(np.mean(U[-n_tail:]))
+    U0 = float(U[0])
+    out = {"initial_speed_mps": U0, "terminal_speed_mps": UT}
+    band = settle_fraction * abs(UT - U0)
+    outside = np.flatnonzero(np.abs(U - UT) > band)
+    k = int(outside[-1]) + 1 if outside.size else 0
+    if k >= len(t):
+        out["not_settled"] = True
+        return out
+    if k > 0:
+        # interpolate the entry into the band between samples k-1 and k
+        f0, f1 = abs(U[k - 1] - UT) - band, abs(U[k] - UT) - band
+        a = f0 / (f0 - f1) if f0 != f1 else 1.0
+        te = t[k - 1] + a * (t[k] - t[k - 1])
+    else:
+        te = t[0]
+    out["time_to_terminal_speed_s"] = te - t[0]
+    out["reach_m"] = _interp(t, along, te)
+    out["track_distance_m"] = _interp(t, path, te)
+    c90 = _first_crossing(t, np.sign(UT - U0) * (U - U0), 0.9 * abs(UT - U0))
+    if c90 is not None:
+        out["time_to_90_percent_s"] = c90[0] - t[0]
+    return out

@@ -19,7 +19,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from . import propulsion
+from . import propulsion, wind
 from .errors import InputError
 from .forces import hull_blanke, hull_mmg, hydrostatics, propeller, rudder
 from .schema import load_toml, num, read_table, text, unknown_key, vector
@@ -123,6 +123,57 @@ class Autopilot:
 
 _SECTIONS = {"meta": Meta, "particulars": Particulars, "inertia": Inertia, "hydrostatics": Hydrostatics,
              "added_mass": AddedMass, "damping": Damping, "autopilot": Autopilot}
+ORDERS = ("ahead_1_3", "ahead_2_3", "standard", "full", "flank", "stop",
+          "back_1_3", "back_2_3", "back_full", "back_emergency")
+
+
+@dataclasses.dataclass(frozen=True)
+class TelegraphOrder:
+    """What an engine order sets on every shaft: r/min (at the edge, converted to rev/s) and pitch."""
+
+    rpm: float = num("shaft speed order (negative: astern rotation)", "r/min", -5000.0, 5000.0)
+    pitch: float = num("pitch ratio order (controllable pitch only)", "", -2.0, 3.0, default=None)
+
+
+def _read_telegraph(tab, f: str, shafts: list, props: list) -> tuple[dict, dict]:
+    """Engine-order table → {order: (rev/s, pitch ratio or None)}, checked against the machinery."""
+    if not isinstance(tab, dict):
+        raise InputError(f, "telegraph", "expected a table of engine orders")
+    default_source = tab.get("source")
+    orders, sources = {}, {}
+    for key, val in tab.items():
+        if key == "source":
+            continue
+        if key not in ORDERS:
+            raise unknown_key(f, "telegraph", key, list(ORDERS))
+        if not isinstance(val, dict):
+            raise InputError(f, f"telegraph.{key}", "expected { rpm = ..., pitch = ..., source = ... }")
+        val = dict(val)
+        src = val.pop("source", default_source)
+        if not (isinstance(src, str) and src.strip()):
+            raise InputError(f, f"telegraph.{key}", "no source given")
+        o, _ = read_table(TelegraphOrder, val, f, f"telegraph.{key}")
+        rps = o.rpm / 60.0
+        for i, sh in enumerate(shafts):
+            if abs(rps) > sh.max_rps + 1e-12:
+                raise InputError(f, f"telegraph.{key}.rpm", f"{o.rpm:g} r/min exceeds shaft {sh.name!r}'s maximum "
+                                                            f"{sh.max_rps * 60:g} r/min")
+            if sh.controllable_pitch:
+                if o.pitch is None:
+                    raise InputError(f, f"telegraph.{key}.pitch", "missing: the propellers are controllable pitch")
+                if not (sh.pitch_min <= o.pitch <= sh.pitch_max):
+                    raise InputError(f, f"telegraph.{key}.pitch", f"{o.pitch:g} outside shaft {sh.name!r}'s pitch range "
+                                                                  f"[{sh.pitch_min:g}, {sh.pitch_max:g}]")
+            elif o.pitch is not None:
+                raise InputError(f, f"telegraph.{key}.pitch", "fixed-pitch propellers take no pitch order")
+        orders[key] = (rps, o.pitch)
+        sources[key] = src
+    missing = [k for k in ORDERS if k not in orders]
+    if missing:
+        raise InputError(f, f"telegraph.{missing[0]}", f"missing engine order (every ship needs {', '.join(ORDERS)})")
+    return orders, sources
+
+
 _HULLS = {"mmg": ("hull_mmg", hull_mmg.HullMMG), "blanke": ("hull_blanke", hull_blanke.HullBlanke)}
 _ARRAYS = {"propeller": propeller.Propeller, "shaft": propulsion.Shaft, "rudder": rudder.Rudder}
 
@@ -153,6 +204,7 @@ class Vessel:
     autopilot: Autopilot
     hull: object
     resistance: object
+    windage: object
     propellers: list
     shafts: list
     rudders: list
@@ -167,7 +219,8 @@ class Vessel:
     B_lin: np.ndarray = None
     rudder_adr: np.ndarray = None  # (nr, 2): qpos address, dof address
     shaft_params: np.ndarray = None  # (ns, NSHAFTP)
-    steering: np.ndarray = None  # (nr, 5): max angle [rad], rate [rad/s], T [s], qadr, dadr
+    steering: np.ndarray = None  # (nr, 6): max angle [rad], rate [rad/s], T [s], qadr, dadr, armature
+    telegraph: dict = None  # engine order → (rev/s, pitch ratio or None)
     components: list = dataclasses.field(default_factory=list)
 
     @property
@@ -218,7 +271,7 @@ def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
                              f"unknown ship {str(name_or_path)!r} (available: {', '.join(available_models())})")
     f = str(toml_path)
     doc = load_toml(toml_path)
-    known = list(_SECTIONS) + [v[0] for v in _HULLS.values()] + list(_ARRAYS) + ["resistance"]
+    known = list(_SECTIONS) + [v[0] for v in _HULLS.values()] + list(_ARRAYS) + ["resistance", "telegraph", "windage"]
     for key in doc:
         if key not in known:
             raise unknown_key(f, "", key, known)
@@ -255,6 +308,10 @@ def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
     elif "resistance" in doc:
         raise InputError(f, "resistance", "only the blanke hull model takes a resistance table")
     parts["resistance"] = resistance
+    windage = None
+    if "windage" in doc:
+        windage, sources["windage"] = read_table(wind.Windage, doc["windage"], f, "windage", sourced=True)
+    parts["windage"] = windage
     arrays: dict[str, list] = {}
     for sec, cls in _ARRAYS.items():
         items = doc.get(sec, [])
@@ -265,7 +322,11 @@ def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
             obj, src = read_table(cls, tab, f, f"{sec}[{i}]", sourced=True)
             arrays[sec].append(obj)
             sources[f"{sec}[{i}]"] = src
+    if "telegraph" not in doc:
+        raise InputError(f, "telegraph", "missing section (engine orders → r/min and pitch)")
+    telegraph, sources["telegraph"] = _read_telegraph(doc["telegraph"], f, arrays["shaft"], arrays["propeller"])
     vessel = _assemble(toml_path, meta, parts, hull, arrays, sources)
+    vessel.telegraph = telegraph
     return vessel
 
 
@@ -408,6 +469,7 @@ def _assemble(toml_path: Path, meta: Meta, parts: dict, hull, arrays: dict, sour
     v = Vessel(name=meta.name, folder=folder, toml_path=toml_path, mjcf_path=mjcf_path, meta=meta,
                particulars=P, inertia=I, hydrostatics=H, added_mass=A, damping=D,
                autopilot=parts["autopilot"], hull=hull, resistance=parts["resistance"],
+               windage=parts["windage"],
                propellers=props, shafts=shafts, rudders=rudders, sources=sources, model=model, sites=sites)
     v.mass = mass
     v.r_G = r_G
@@ -463,6 +525,8 @@ def _derive(v: Vessel) -> None:
         comps.append(Component(f"rudder:{rd.name}", rudder.KIND,
                                rudder.pack(rd, k, kp, v.propellers[kp].diameter, Lpp, rho, u_floor,
                                                v.hull.z_H)))
+    if v.windage is not None:
+        comps.append(Component("wind", wind.KIND, wind.pack_wind(v.windage)))
     comps.append(Component("hydrostatics", hydrostatics.KIND_RESTORING,
                            hydrostatics.pack_restoring(v.mass, G, rho, P.displacement, H.waterplane_area, H.x_F,
                                                        H.GM_T, H.GM_L, v.r_G, P.draught - H.KB)))

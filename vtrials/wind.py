@@ -119,7 +119,7 @@ from .forces import layout as L
 from .schema import integer, num, text
 from .units import DEG, KNOT
 
-KIND = 6  # force-component kind for the dynamics dispatch (hull 1, propeller 2, rudder 3, hydrostatics 4, 5)
+KIND = 7  # force-component kind for the dynamics dispatch (see vtrials.dynamics.dispatch)
 
 RHO_AIR = 1.225  # [kg/m³] ISO 2533:1975 standard atmosphere, sea level, 15 °C
 ISO15016_EXPONENT = 1.0 / 7.0  # power-law exponent of the mean wind profile, ISO 15016:2015
@@ -136,7 +136,8 @@ E_WIND_DIR = 17  # direction the wind blows FROM [rad], north = 0, clockwise
 E_WIND_ALPHA = 18  # power-law exponent of the mean profile [–]
 E_WIND_ZREF = 19  # reference height of the ship's wind loads (and of the gusts) [m]
 E_WIND_NG = 20  # number of gust components n_g (stored as a float)
-E_GUST = 64  # gusts: amplitudes [m/s] at E_GUST..+n_g−1, ω [rad/s] at +n_g..+2n_g−1, phases [rad] at +2n_g..+3n_g−1
+E_GUST = 64  # gust components, blocked: amplitudes [m/s] at E_GUST + k, angular frequencies [rad/s] at
+#              E_GUST + n_g + k, phases [rad] at E_GUST + 2 n_g + k, k = 0..n_g−1 (block length 64 + 3 n_g)
 
 # --- context slots written by the kernel (inside layout.WIND, 33..39) --------------------------
 C_WIND_REL_SPEED = L.WIND + 0  # 33: apparent wind speed V_r [m/s]
@@ -452,7 +453,11 @@ def apparent_wind(U_true, direction_from, u, v, heading):
     wy = -np.asarray(U_true, dtype=float) * np.sin(rel)
     ax = wx - u
     ay = wy - v
-    return np.hypot(ax, ay), np.arctan2(-ay, -ax)
+    Vr = np.hypot(ax, ay)
+    gam = np.where(Vr > 0.0, np.arctan2(-ay, -ax), 0.0)  # dead calm: 0 by convention
+    if np.ndim(Vr) == 0:
+        return float(Vr), float(gam)
+    return Vr, gam
 
 
 # =================================================================================================
@@ -588,7 +593,7 @@ def wind_kernel(p, env, ctx, aux, w):
     ay = wby - ctx[L.NU + 1]
     Vr2 = ax * ax + ay * ay
     Vr = math.sqrt(Vr2)
-    gam = math.atan2(-ay, -ax)  # direction it comes FROM, + to starboard
+    gam = math.atan2(-ay, -ax) if Vr2 > 0.0 else 0.0  # direction it comes FROM, + to starboard
     a_deg = abs(gam) * (180.0 / math.pi)
     sgn = 1.0 if gam >= 0.0 else -1.0
     cx = -_table_interp(p, P_CX, a_deg)

@@ -115,7 +115,7 @@ def kernel(p, env, ctx, aux, w):
     delta = ctx[L.DELTA + k]
     b = L.AUX_PROP + 8 * kp
     uP = aux[b + L.P_UA]
-    eta = D / HR
+    eta = min(D / HR, 1.0)  # the share of the rudder span in the propeller race
     # 8 K_T n² D²/π written with the thrust itself, 8T/(πρD²): valid in every quadrant
     jet = uP * uP + 8.0 * aux[b + L.P_THRUST] / (math.pi * rho * D * D)
     if jet < 0.0:
