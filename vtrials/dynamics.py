@@ -123,14 +123,15 @@ def _clip(x, lim):
 
 
 def record_width(n_rudders: int, n_shafts: int, n_components: int) -> int:
-    return 30 + 2 * n_rudders + 5 * n_shafts + 3 * n_shafts + n_rudders + 6 * (n_components + 1)
+    return 34 + 2 * n_rudders + 5 * n_shafts + 3 * n_shafts + n_rudders + 6 * (n_components + 1)
 
 
 def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[str]:
     """Column names of the truth record, in the kernel's order (units in :mod:`vtrials.truth`)."""
     names = ["t", "x", "y", "z", "qw", "qx", "qy", "qz", "roll", "pitch", "heading",
              "u", "v", "w", "p", "q", "r", "u_r", "v_r", "w_r",
-             "du", "dv", "dw", "dp", "dq", "dr", "current_n", "current_e", "drift_n", "drift_e"]
+             "du", "dv", "dw", "dp", "dq", "dr", "current_n", "current_e", "drift_n", "drift_e",
+             "wind_apparent_speed", "wind_apparent_angle", "wind_speed", "wind_direction"]
     names += [f"rudder_{k}" for k in range(n_rudders)] + [f"rudder_order_{k}" for k in range(n_rudders)]
     names += [f"shaft_n_{k}" for k in range(n_shafts)] + [f"shaft_order_{k}" for k in range(n_shafts)]
     names += [f"engine_torque_{k}" for k in range(n_shafts)]
@@ -386,7 +387,9 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
             row[27] = vce
             row[28] = nav[i, NV_DN]
             row[29] = nav[i, NV_DE]
-            o = 30
+            for j in range(4):
+                row[30 + j] = c[L.WIND + j]
+            o = 34
             for k in range(nr):
                 row[o + k] = c[L.DELTA + k]
                 row[o + nr + k] = rud_cmd[i, k]

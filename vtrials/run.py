@@ -22,7 +22,7 @@ import numpy as np
 
 from . import __version__
 from . import helm as H
-from .errors import InputError
+from .errors import InputError, SimulationError
 from .maneuvers import Progress
 from .records import atomic_path, write_groups
 from .scenario import Scenario, load_scenario
@@ -82,17 +82,38 @@ def _autopilot_args(scn: Scenario) -> tuple:
             kp * ap.derivative_time)
 
 
+def _approach_field(scn: Scenario, i: int, m) -> str:
+    """The scenario field that set ship i's approach (for error messages)."""
+    if m.approach_order is not None:
+        return f"maneuver[{i}].approach_order"
+    if m.approach_speed_kn is not None:
+        return f"maneuver[{i}].approach_speed_kn"
+    init = scn.initial
+    return "initial." + next(k for k in ("engine_order", "froude_number", "speed_kn", "speed_mps")
+                             if getattr(init, k) is not None)
+
+
 def _approach(sim: Simulator, i: int, scn: Scenario, m) -> ShipState:
-    """The steady condition ship i starts its approach in (also placed on it)."""
+    """The steady condition ship i starts its approach in (also placed on it). An approach the
+    machinery cannot deliver (r/min or power beyond the engine's limits) is an input error."""
     v = scn.vessel
+    f = str(scn.path)
     order = m.approach_order or (scn.initial.engine_order if m.approach_speed_kn is None else None)
-    if order is not None:
-        rps, pitch = v.telegraph[order]
-        pitches = (pitch,) * sim.ns if pitch is not None else ()
-        s = sim.steady_at_order(i, (rps,) * sim.ns, pitches, heading=scn.heading)
-    else:
-        U = m.approach_speed_kn * KNOT if m.approach_speed_kn is not None else scn.speed
-        s = sim.self_propulsion(i, U, scn.heading)
+    try:
+        if order is not None:
+            rps, pitch = v.telegraph[order]
+            pitches = (pitch,) * sim.ns if pitch is not None else ()
+            s = sim.steady_at_order(i, (rps,) * sim.ns, pitches, heading=scn.heading)
+        else:
+            U = m.approach_speed_kn * KNOT if m.approach_speed_kn is not None else scn.speed
+            s = sim.self_propulsion(i, U, scn.heading)
+    except SimulationError as exc:
+        raise InputError(f, _approach_field(scn, i, m), f"the machinery cannot give this approach: {exc}") from None
+    for k, (power, sh) in enumerate(zip(sim.shaft_power(i), v.shafts)):
+        if abs(power) > sh.max_power * (1 + 1e-9):
+            raise InputError(f, _approach_field(scn, i, m),
+                             f"needs {power / 1e6:.2f} MW on shaft {sh.name!r}, above its limit of "
+                             f"{sh.max_power / 1e6:.2f} MW")
     modes = ["governed"] * sim.ns
     names = [sh.name for sh in v.shafts]
     if m.trailed_shaft is not None:
@@ -125,13 +146,14 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
     for i in range(N):  # every ship placed last, so no steady-state search disturbs another
         sim.set_state(i, starts[i])
         sim.set_helm(i, [(H.HEADING, scn.heading, *ap)])
-    U_ref = max([abs(s.u) for s in starts] + [0.1 * math.sqrt(9.80665 * vessel.length)])
-    L_over_U = vessel.length / U_ref
+    # each ship's time scale L/U from its own approach speed (at least Fn 0.1)
+    L_over_U = [vessel.length / max(abs(s.u), 0.1 * math.sqrt(9.80665 * vessel.length)) for s in starts]
     execute_step = []
-    for m in scn.maneuvers:
-        approach = m.approach_s if m.approach_s is not None else 3.0 * L_over_U
+    for i, m in enumerate(scn.maneuvers):
+        approach = m.approach_s if m.approach_s is not None else 3.0 * L_over_U[i]
         execute_step.append(int(round(approach / dt)))
-    max_dur = [m.max_duration_s or 60.0 * L_over_U for m in scn.maneuvers]
+    max_dur = [m.max_duration_s or (60.0 * L_over_U[i] + getattr(m, "duration_s", 0.0))
+               for i, m in enumerate(scn.maneuvers)]
     t_exec = [math.nan] * N
     psi_exec = [0.0] * N
     t_finex = [math.nan] * N
@@ -167,7 +189,7 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
             phase = sim.helm_phase(i)
             tstart = sim.hs[i, H.H_TSTART]
             pe = t_i - tstart if tstart >= 0 else 0.0
-            prog = Progress(t_i - t_exec[i], float(sim.nav[i, 0]) - psi_exec[i], phase, pe, 10.0 * L_over_U,
+            prog = Progress(t_i - t_exec[i], float(sim.nav[i, 0]) - psi_exec[i], phase, pe, 10.0 * L_over_U[i],
                             surge=float(sim.ctx[i, L.NU_R]), speed_rate=rate)
             if scn.maneuvers[i].finished(prog):
                 t_finex[i] = t_i

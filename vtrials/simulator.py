@@ -249,6 +249,16 @@ class Simulator:
         self.hs[ship, H.H_TSTART] = -1.0
         self.hs[ship, H.H_ACTIVE] = 1.0 if phases else 0.0
 
+    def shaft_power(self, ship: int) -> list[float]:
+        """Delivered power of each shaft at the ship's current state [W] (propeller torque × 2πn)."""
+        self.evaluate()
+        out = []
+        for k in range(self.ns):
+            kp = int(self.shaftp[k, S_PROP])
+            out.append(float(2 * math.pi * self.ctx[ship, L.SHAFT_N + kp]
+                             * self.aux[ship, L.AUX_PROP + 8 * kp + L.P_TORQUE]))
+        return out
+
     def set_order(self, ship: int, rps: float, pitch: float | None = None) -> None:
         """An engine order on every governed shaft: shaft speed [rev/s] and pitch ratio (CP only)."""
         for k in range(self.ns):

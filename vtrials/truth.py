@@ -41,6 +41,10 @@ _FIXED = {
     "current_e": ("m s-1", "current at the ship, east component"),
     "drift_n": ("m", "integrated current (north): position minus this is the track through the water"),
     "drift_e": ("m", "integrated current (east)"),
+    "wind_apparent_speed": ("m s-1", "apparent (relative) wind speed at the ship's wind-load reference height"),
+    "wind_apparent_angle": ("rad", "angle the apparent wind comes from, off the bow, + to starboard"),
+    "wind_speed": ("m s-1", "true wind speed at the reference height, gusts included"),
+    "wind_direction": ("rad", "direction the true wind blows from (north = 0, clockwise)"),
 }
 _PATTERNS = [
     (r"rudder_order_(\d+)", ("rad", "rudder order of rudder {0} (+ starboard turn)")),

@@ -517,9 +517,10 @@ def _derive(v: Vessel) -> None:
         comps = [Component("hull", hull_blanke.KIND,
                            hull_blanke.pack(v.hull, np.array(v.resistance.speeds), np.array(v.resistance.values)))]
     pnames = [p.name for p in v.propellers]
+    rot = {sh.propeller: sh.rotation for sh in v.shafts}
     for k, pr in enumerate(v.propellers):
         comps.append(Component(f"propeller:{pr.name}", propeller.KIND,
-                               propeller.pack(pr, k, Lpp, rho, u_floor)))
+                               propeller.pack(pr, k, Lpp, rho, u_floor, rot[pr.name])))
     for k, rd in enumerate(v.rudders):
         kp = pnames.index(rd.propeller)
         comps.append(Component(f"rudder:{rd.name}", rudder.KIND,

@@ -19,7 +19,10 @@ C_T*, C_Q* come from two parts:
    the rotation direction,
        C_T* = k_A (c_N cos φ − c_F cos α sin φ),   C_Q* = k_A r_q (c_N sin φ + c_F cos α cos φ).
    k_A, α₀, c_F and r_q are fitted (at load) to the own curve at the design pitch, so the two
-   parts agree where both exist; η_r is a stated assumption. The section model is 2π-periodic and
+   parts agree where both exist; η_r is a stated assumption. A one-radius section model makes
+   thrust grow too slowly with pitch (it leaves out the induced inflow), so for a series curve k_A
+   is multiplied by a quadratic g(P/D) fitted to the series' bollard thrust over its pitch range and
+   held at its end values beyond. The section model is 2π-periodic and
    smooth in β, so thrust and torque are continuous across every quadrant boundary, through
    windmilling, locked-propeller drag, crash-back and backing, and through zero and negative
    pitch (controllable-pitch reversal).
@@ -29,7 +32,10 @@ of its validity, keeping continuity.
 Wake: MMG maneuvering wake (1 − w_P)/(1 − w_P0) = 1 + [1 − exp(−C₁|β_P|)](C₂ − 1) (Yasukawa &
 Yoshimura 2015) or a constant w_P0; no wake when the ship goes astern (the propeller then leads
 the hull; u_A = u(1 − w) is continuous at u = 0). Thrust deduction t_P ahead, t_P_astern for
-negative thrust.
+negative thrust. When the thrust is negative the propeller also pushes its stern sideways (the
+unequal blade loading of the upper and lower halves in the hull's wake): a lateral force
+Y_P = rot·sign(n)·c_side·|T| (right-handed propeller going astern: stern to port, bow to starboard;
+twin screws turning outward cancel), c_side a stated fraction, zero for positive thrust.
 """
 
 from __future__ import annotations
@@ -82,6 +88,9 @@ class Propeller:
     pitch_ratio: float = num("design pitch ratio P/D at 0.7R", "", 0.3, 2.0)
     reverse_efficiency: float = num("reverse-flow efficiency η_r of the section model", "", 0.3, 1.0,
                                     default=0.75)
+    backing_side_force: float = num("transverse force of the propeller when its thrust is negative, as a "
+                                    "fraction of |T| (the 'paddle-wheel' effect when backing)", "", 0.0, 0.5,
+                                    default=0.0)
 
     def own_curve(self) -> tuple[np.ndarray, np.ndarray, float, float, float]:
         """(K_T terms, K_Q terms, J_hi or J_hi per P/D, P/D low, P/D high) of the own curve."""
@@ -134,20 +143,42 @@ def fit_section_model(prop: Propeller) -> tuple[np.ndarray, float]:
     return p, float(np.max(np.abs(a - ct) * den / 8))
 
 
-def pack(pr: Propeller, index: int, length: float, rho: float, u_floor: float) -> np.ndarray:
+def pitch_gain(prop: Propeller, p: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Quadratic g(P/D) that scales the section model to the own curve's bollard thrust at every pitch
+    of the own curve's range (the one-radius section model under-predicts how thrust grows with
+    pitch, the induced inflow being left out); returns (g coefficients, P/D low, P/D high), g held
+    constant outside. A fixed-pitch own curve has one pitch: g = 1."""
+    kt_t, _, _, pd_lo, pd_hi = prop.own_curve()
+    if prop.curve == "polynomial":
+        return np.array([1.0, 0.0, 0.0]), prop.pitch_ratio, prop.pitch_ratio
+    lo = pd_lo - TAPER_PD
+    pds = np.linspace(lo, pd_hi, 25)
+    ratio = []
+    for pd in pds:
+        ct_sec, _ = section_coefficients(np.array([0.0]), math.atan(pd / K07), p)
+        kt0 = float(_eval_terms(kt_t, 0.0, pd))
+        ratio.append(8 * kt0 / (math.pi * K07 ** 2) / ct_sec[0])
+    g = np.polynomial.polynomial.polyfit(pds, ratio, 2)
+    return g, lo, pd_hi
+
+
+def pack(pr: Propeller, index: int, length: float, rho: float, u_floor: float, rotation: int = 1) -> np.ndarray:
     kt_t, kq_t, jhi, pd_lo, pd_hi = pr.own_curve()
     sec, _ = fit_section_model(pr)
+    g, g_lo, g_hi = pitch_gain(pr, sec)
     wake = 1.0 if pr.wake_model == "mmg" else 0.0
     head = [index, length, rho, u_floor, pr.diameter, pr.x, pr.y, pr.z, pr.t_P, pr.t_P_astern, wake, pr.w_P0,
-            pr.x_P_prime, pr.C1, pr.C2_pos, pr.C2_neg, *sec, jhi, pd_lo, pd_hi, len(kt_t), len(kq_t)]
+            pr.x_P_prime, pr.C1, pr.C2_pos, pr.C2_neg, *sec, jhi, pd_lo, pd_hi, rotation * pr.backing_side_force,
+            *g, g_lo, g_hi, len(kt_t), len(kq_t)]
     assert len(head) == P_TERMS
     return np.concatenate([np.array(head, dtype=np.float64), kt_t.ravel(), kq_t.ravel()])
 
 
 # parameter block indices
 (P_IDX, P_L, P_RHO, P_UFLOOR, P_D, P_X, P_Y, P_Z, P_TP, P_TPA, P_WAKE, P_W0, P_XP, P_C1, P_C2P, P_C2N,
- P_KA, P_A0, P_CF, P_RQ, P_ETA, P_JHI, P_PDLO, P_PDHI, P_NT, P_NQ) = range(26)
-P_TERMS = 26
+ P_KA, P_A0, P_CF, P_RQ, P_ETA, P_JHI, P_PDLO, P_PDHI, P_SIDE, P_G0, P_G1, P_G2, P_GLO, P_GHI, P_NT,
+ P_NQ) = range(32)
+P_TERMS = 32
 
 
 @nb.njit(cache=True)
@@ -177,8 +208,10 @@ def coefficients(p, beta, pd):
     ca = math.cos(al)
     fr = 1.0 - (1.0 - p[P_ETA]) * 0.5 * (1.0 - ca)
     cn = fr * math.sin(al + p[P_A0])
-    ct = p[P_KA] * (cn * math.cos(phi) - p[P_CF] * ca * math.sin(phi))
-    cq = p[P_KA] * p[P_RQ] * (cn * math.sin(phi) + p[P_CF] * ca * math.cos(phi))
+    pg = min(max(pd, p[P_GLO]), p[P_GHI])
+    kA = p[P_KA] * (p[P_G0] + pg * (p[P_G1] + pg * p[P_G2]))
+    ct = kA * (cn * math.cos(phi) - p[P_CF] * ca * math.sin(phi))
+    cq = kA * p[P_RQ] * (cn * math.sin(phi) + p[P_CF] * ca * math.cos(phi))
     jhi = -p[P_JHI] if p[P_JHI] < 0.0 else p[P_JHI] * pd
     wgt = _taper(beta, 0.0, math.atan(jhi / K07), TAPER_BETA) * _taper(pd, p[P_PDLO], p[P_PDHI], TAPER_PD)
     if wgt > 0.0:
@@ -232,12 +265,15 @@ def kernel(p, env, ctx, aux, w):
     T = 0.5 * rho * Vr2 * 0.25 * math.pi * D * D * ct
     Q = 0.5 * rho * Vr2 * 0.25 * math.pi * D * D * D * cq
     XP = (1.0 - p[P_TP]) * T if T >= 0.0 else (1.0 - p[P_TPA]) * T
+    YP = 0.0
+    if T < 0.0:
+        YP = p[P_SIDE] * (1.0 if n >= 0.0 else -1.0) * (-T)
     w[0] = XP
-    w[1] = 0.0
+    w[1] = YP
     w[2] = 0.0
-    w[3] = 0.0
+    w[3] = -p[P_Z] * YP
     w[4] = p[P_Z] * XP
-    w[5] = -p[P_Y] * XP
+    w[5] = p[P_X] * YP - p[P_Y] * XP
     b = L.AUX_PROP + 8 * k
     aux[b + L.P_THRUST] = T
     aux[b + L.P_TORQUE] = Q
