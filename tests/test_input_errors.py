@@ -66,7 +66,8 @@ def check(code, err, out, *fragments):
 def test_good_scenario_runs(tmp_path, capsys):
     code, err, out = run_cli(tmp_path, scenario(tmp_path), capsys)
     assert code == 0, err
-    assert {p.name for p in out.iterdir()} == {"results.json", "truth.nc", "trajectory.png"}
+    assert {p.name for p in out.iterdir()} == {"results.json", "truth.nc", "trajectory.png", "records"}
+    assert [p.name for p in (out / "records").iterdir()] == ["turn.nc"]
 
 
 def test_malformed_toml(tmp_path, capsys):

@@ -91,3 +91,71 @@ def _plain(v):
     if isinstance(v, bytes):
         return v.decode()
     return v
+
+
+# --------------------------------------------------------------------------- trial records (reader)
+import json  # noqa: E402
+
+
+class RecordError(ValueError):
+    """A file that is not a trial record (or a truth file offered to a reduction)."""
+
+
+class Record:
+    """A trial record as a trials team has it: instrument channels on their own clocks, event marks
+    and the team's knowledge (ship particulars, surveyed positions, nominal calibrations).
+
+    Opening a truth file raises :class:`RecordError`: reductions never read truth.
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        data = read_groups(self.path)
+        content = data["attrs"].get("content")
+        if content != "record":
+            raise RecordError(f"{self.path}: not a trial record (content = {content!r}); reductions read "
+                              f"records only")
+        self.attrs = data["attrs"]
+        self._groups = data["groups"]
+        self.team = json.loads(self.attrs.get("team_knowledge", "{}"))
+
+    @property
+    def instruments(self) -> list[str]:
+        return [g for g in self._groups if not g.startswith("_")]
+
+    def channels(self, instrument: str) -> list[str]:
+        return [v for v in self._groups[instrument]["variables"] if v != "time"]
+
+    def channel(self, instrument: str, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """(time [s] on the instrument's own clock, values in SI units)."""
+        g = self._groups[instrument]
+        return g["variables"]["time"], g["variables"][name]
+
+    def units(self, instrument: str, name: str) -> str:
+        return self._groups[instrument]["units"].get(name, "")
+
+    def meta(self, instrument: str) -> dict:
+        a = dict(self._groups[instrument]["attrs"])
+        for k, v in list(a.items()):
+            if isinstance(v, str) and v[:1] in "{[":
+                try:
+                    a[k] = json.loads(v)
+                except ValueError:
+                    pass
+        return a
+
+    @property
+    def events(self) -> dict:
+        """Event marks as logged by the data acquisition system: time, run number, code, label."""
+        g = self._groups.get("_events")
+        if g is None:
+            return {"time": np.zeros(0), "run": np.zeros(0, int), "code": np.zeros(0, int), "label": []}
+        codes = json.loads(g["attrs"]["codes"])
+        code = g["variables"]["code"].astype(int)
+        return {"time": g["variables"]["time"], "run": g["variables"]["run"].astype(int), "code": code,
+                "label": [codes[str(c)] for c in code]}
+
+
+def open_record(path: str | Path) -> Record:
+    """Open a trial record for reading (numpy arrays out)."""
+    return Record(path)

@@ -28,7 +28,9 @@ from .records import atomic_path, write_groups
 from .scenario import Scenario, load_scenario
 from .forces import layout as L
 from .sea import pack as pack_env
+from .instruments.suite import InstrumentSet
 from .simulator import ShipState, Simulator
+from .trialrecord import write_record
 from .wind import pack_env as pack_wind
 from .truth import describe, ship_columns
 from .units import DEG, KNOT, speed_to_froude
@@ -43,6 +45,9 @@ class ManeuverRun:
     completed: bool
     truth: dict  # metrics
     columns: dict  # truth arrays from t = 0 to FINEX
+    instruments: object = None  # the InstrumentSet that recorded this run
+    events: list = dataclasses.field(default_factory=list)  # (time, run, code)
+    orders: list = dataclasses.field(default_factory=list)  # (time, engine order)
 
 
 @dataclasses.dataclass
@@ -80,6 +85,9 @@ def _autopilot_args(scn: Scenario) -> tuple:
     kp = ap.gain
     return (min(ap.rudder_limit_deg * DEG, scn.vessel.max_rudder), kp, kp / ap.integral_time,
             kp * ap.derivative_time)
+
+
+INSTRUMENT_CHUNK = 2500  # truth rows per instrument call (streaming, as in the loop of a trial)
 
 
 def _approach_field(scn: Scenario, i: int, m) -> str:
@@ -212,7 +220,16 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
         metrics = m.truth({k: v[ex] for k, v in cols.items()}) if np.count_nonzero(ex) > 2 else {}
         if not completed[i]:
             metrics["incomplete"] = f"FINEX condition not reached within {max_dur[i]:.0f} s after EXECUTE"
-        runs.append(ManeuverRun(m.name, m.kind, t_exec[i], t_finex[i], completed[i], metrics, cols))
+        iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path), stream=(i,))
+        iset.reset()
+        n = len(cols["t"])
+        for a in range(0, n, INSTRUMENT_CHUNK):
+            iset.process({k: v[a:a + INSTRUMENT_CHUNK] for k, v in cols.items()})
+        events = [(max(0.0, t_exec[i] - 60.0), i + 1, 1), (t_exec[i], i + 1, 2), (t_finex[i], i + 1, 3)]
+        order0 = m.approach_order or (scn.initial.engine_order if m.approach_speed_kn is None else None)
+        orders = ([(0.0, order0)] if order0 else []) + ([(t_exec[i], m.order)] if getattr(m, "order", None) else [])
+        runs.append(ManeuverRun(m.name, m.kind, t_exec[i], t_finex[i], completed[i], metrics, cols, iset, events,
+                                orders))
     s0 = starts[0]
     U0 = abs(s0.u)
     initial = {"speed_mps": U0, "froude_number": speed_to_froude(U0, vessel.length),
@@ -233,9 +250,11 @@ def write_truth(result: RunResult, path: Path) -> None:
                 continue
             units, long_name = describe(name)
             variables[name] = (m.columns[name], units, long_name)
-        groups[m.name] = {"time": m.columns["t"], "variables": variables,
-                          "attrs": {"kind": m.kind, "execute_time_s": m.execute_time_s,
-                                    "finex_time_s": m.finex_time_s, "completed": m.completed}}
+        attrs = {"kind": m.kind, "execute_time_s": m.execute_time_s, "finex_time_s": m.finex_time_s,
+                 "completed": m.completed}
+        if m.instruments is not None:
+            attrs["instrument_errors"] = json.dumps(m.instruments.drawn(), sort_keys=True)
+        groups[m.name] = {"time": m.columns["t"], "variables": variables, "attrs": attrs}
     attrs = {"Conventions": "CF-1.10", "title": f"vtrials truth: {s.head.title}", "content": "truth",
              "ship": s.vessel.name, "seed": s.head.seed, "timestep_s": s.head.timestep_s,
              "vtrials_version": __version__,
@@ -262,6 +281,12 @@ def write_outputs(result: RunResult, out_dir: str | Path, plot: bool = True) -> 
         raise InputError(str(out), "--out", "exists and is not a directory")
     out.mkdir(parents=True, exist_ok=True)
     write_truth(result, out / "truth.nc")
+    for i, m in enumerate(result.maneuvers):
+        if m.instruments is not None:
+            write_record(out / "records" / f"{m.name}.nc", m.instruments, m.finex_time_s, m.events, m.orders,
+                         f"vtrials trial record: {m.name} ({m.kind}) — {result.scenario.head.title}",
+                         {"trial": m.name, "kind": m.kind, "ship": result.scenario.vessel.name,
+                          "scenario_file": result.scenario.path.name})
     if plot:
         from .plots import trajectory_plot
         with atomic_path(out / "trajectory.png") as tmp:

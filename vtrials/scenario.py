@@ -56,6 +56,30 @@ class Environment:
                                lo_open=True, default=10000.0)
 
 
+@dataclasses.dataclass(frozen=True)
+class Site:
+    """The trial site as the trials team surveyed it (positions north, east in the range's frame, m)."""
+
+    latitude_deg: float = num("latitude of the range", "deg", -90.0, 90.0, default=38.0)
+    transponder_side: float = num("side of the transponder baseline A→B the ship works on: +1 starboard "
+                                  "(right) of A→B, −1 port", "", -1.0, 1.0, default=-1.0)
+    hydrophone_side: float = num("side of the hydrophone pair 1→2 the ship works on (±1)", "", -1.0, 1.0,
+                                 default=-1.0)
+
+
+DEFAULT_TRANSPONDERS = [[-10000.0, -6000.0], [-10000.0, 6000.0]]  # 10 km south of the range centre
+DEFAULT_HYDROPHONES = [[-600.0, -800.0], [-600.0, 800.0]]
+
+
+def _points(val, f: str, field: str, n_min: int) -> list:
+    ok = isinstance(val, list) and len(val) >= n_min and all(
+        isinstance(p, list) and len(p) == 2 and all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                                                    for c in p) for p in val)
+    if not ok:
+        raise InputError(f, field, f"expected at least {n_min} [north, east] pairs in metres, got {val!r}")
+    return [[float(a), float(b)] for a, b in val]
+
+
 @dataclasses.dataclass
 class Scenario:
     path: Path
@@ -66,6 +90,8 @@ class Scenario:
     wind: Wind
     maneuvers: list
     vessel: Vessel
+    site: dict = dataclasses.field(default_factory=dict)
+    instrument_items: list = dataclasses.field(default_factory=list)
 
     @property
     def speed(self) -> float:
@@ -84,7 +110,7 @@ class Scenario:
         return self.initial.heading_deg * DEG
 
 
-_TOP = ("scenario", "initial", "environment", "maneuver")
+_TOP = ("scenario", "initial", "environment", "maneuver", "site", "instrument")
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -154,7 +180,19 @@ def load_scenario(path: str | Path) -> Scenario:
         if m.trailed_shaft is not None and m.locked_shaft is not None and len(shaft_names) == 2:
             raise InputError(f, f"{sec}.locked_shaft", "no shaft would be left driving")
         maneuvers.append(m)
-    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel)
+    site_tab = dict(doc.get("site", {}))
+    if not isinstance(site_tab, dict):
+        raise InputError(f, "site", "expected a table")
+    tr = _points(site_tab.pop("transponders", DEFAULT_TRANSPONDERS), f, "site.transponders", 2)
+    hy = _points(site_tab.pop("hydrophones", DEFAULT_HYDROPHONES), f, "site.hydrophones", 2)
+    site_obj, _ = read_table(Site, site_tab, f, "site")
+    site = {"transponders": tr, "hydrophones": hy, "transponder_side": site_obj.transponder_side,
+            "hydrophone_side": site_obj.hydrophone_side, "latitude_deg": site_obj.latitude_deg,
+            "water_depth_m": env.water_depth_m}
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []))
+    # the instrument suite (and the scenario's additions) are checked now, before anything runs
+    from .instruments.suite import InstrumentSet
+    InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
     if init.engine_order is None and scn.speed > 0.9 * _runaway_speed(vessel):
         raise InputError(f, "initial", f"approach speed {scn.speed:.2f} m/s is beyond this hull model's range")
     return scn

@@ -1,0 +1,176 @@
+"""vtrials.reduce.logcal: regression statistics against a textbook example and an independent
+linear-algebra computation; band coverage; the seed 000 (R/V ATHENA) numbers the seed copy allows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from vtrials.reduce import logcal as L
+from vtrials.units import KNOT
+
+# Montgomery & Runger, Applied Statistics and Probability for Engineers, ch. 11, Table 11-1:
+# hydrocarbon level x [%] and oxygen purity y [%] of 20 distillation runs (the chapter's running
+# example). Printed there: x̄ = 1.1960, ȳ = 92.1605, S_xx = 0.68088, S_xy = 10.17744,
+# β̂₁ = 14.947, β̂₀ = 74.283, σ̂² = 1.18, se(β̂₁) = 1.317, se(β̂₀) = 1.593, R² = 0.877,
+# 95 % CI on the mean response at x₀ = 1.00 %: 88.48 ≤ μ ≤ 89.98, 95 % prediction interval at
+# x₀ = 1.00 %: 86.83 ≤ y₀ ≤ 91.63. (Values quoted from the book's worked examples, as recalled; the
+# test below also recomputes every quantity independently with numpy linear algebra.)
+MR_X = np.array([0.99, 1.02, 1.15, 1.29, 1.46, 1.36, 0.87, 1.23, 1.55, 1.40,
+                 1.19, 1.15, 0.98, 1.01, 1.11, 1.20, 1.26, 1.32, 1.43, 0.95])
+MR_Y = np.array([90.01, 89.05, 91.43, 93.74, 96.73, 94.45, 87.59, 91.77, 99.42, 93.65,
+                 93.54, 92.52, 90.56, 89.54, 89.85, 90.39, 93.25, 93.41, 94.98, 87.33])
+
+
+def test_montgomery_runger_oxygen_purity_example():
+    c = L.calibrate(MR_X, MR_Y)
+    assert c.xbar == pytest.approx(1.1960, abs=5e-5)
+    assert c.sxx == pytest.approx(0.68088, abs=5e-6)
+    assert c.beta1.value == pytest.approx(14.947, abs=5e-4)
+    assert c.beta0.value == pytest.approx(74.283, abs=5e-4)
+    assert c.see ** 2 == pytest.approx(1.18, abs=5e-3)
+    assert c.beta1.std == pytest.approx(1.317, abs=1e-3)
+    assert c.beta0.std == pytest.approx(1.593, abs=1e-3)
+    assert c.r2 == pytest.approx(0.877, abs=5e-4)
+    lo, hi = c.band(1.00)
+    assert (float(lo), float(hi)) == pytest.approx((88.48, 89.98), abs=1e-2)  # book: 89.23 ± 0.75
+    plo, phi = c.band(1.00, prediction=True)
+    assert (float(plo), float(phi)) == pytest.approx((86.83, 91.63), abs=1e-2)
+    assert c.dof == 18 and c.beta1.dof == 18
+
+
+def test_regression_matches_independent_linear_algebra():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(10, 100, 15)
+    y = 0.5 + 0.15 * x + rng.normal(0, 0.2, x.size)
+    X = np.column_stack([np.ones_like(x), x])
+    beta, *_ = np.linalg.lstsq(X, y, rcond=None)
+    r = y - X @ beta
+    s2 = r @ r / (x.size - 2)
+    cov = s2 * np.linalg.inv(X.T @ X)
+    c = L.calibrate(x, y)
+    assert [c.beta0.value, c.beta1.value] == pytest.approx(beta, rel=1e-12)
+    assert np.allclose(c.cov, cov, rtol=1e-10)
+    assert c.see == pytest.approx(math.sqrt(s2), rel=1e-12)
+    assert c.r2 == pytest.approx(np.corrcoef(x, y)[0, 1] ** 2, rel=1e-12)
+    x0 = np.array([5.0, 55.0, 120.0])
+    g = np.column_stack([np.ones_like(x0), x0])
+    se_mean = np.sqrt(np.einsum("ij,jk,ik->i", g, cov, g))
+    assert np.allclose(c.se_mean(x0), se_mean, rtol=1e-10)
+    tq = stats.t.ppf(0.975, x.size - 2)
+    plo, phi = c.band(x0, prediction=True)
+    assert np.allclose(phi - plo, 2 * tq * np.sqrt(se_mean ** 2 + s2), rtol=1e-10)
+
+
+def test_weighted_regression():
+    rng = np.random.default_rng(1)
+    x = np.linspace(5, 30, 10)
+    sig = np.linspace(0.05, 0.3, 10)
+    y = 0.4 + 0.3 * x + sig * rng.standard_normal(10)
+    c = L.calibrate(x, y, std=sig)  # σᵢ known
+    X = np.column_stack([np.ones_like(x), x])
+    W = np.diag(1 / sig ** 2)
+    cov = np.linalg.inv(X.T @ W @ X)
+    beta = cov @ X.T @ W @ y
+    assert [c.beta0.value, c.beta1.value] == pytest.approx(beta, rel=1e-10)
+    assert np.allclose(c.cov, cov, rtol=1e-10)
+    assert c.beta1.dof is None  # known σ → normal quantiles
+    # equal weights reproduce the unweighted fit with relative weighting
+    cu, cw = L.calibrate(x, y), L.calibrate(x, y, std=0.7, absolute_sigma=False)
+    assert cw.beta1.value == pytest.approx(cu.beta1.value, rel=1e-12)
+    assert cw.beta1.std == pytest.approx(cu.beta1.std, rel=1e-10)
+
+
+def test_band_coverage_monte_carlo():
+    """Mean-response band covers the true line, prediction band covers a new observation, each at
+    95 % ± 3 binomial standard errors over 400 realizations."""
+    rng = np.random.default_rng(2)
+    x = np.array([18.0, 33.0, 48.0, 64.0, 82.0, 94.0])  # count rates [1/s], ~5–30 kn
+    b0, b1, sig = 1.5 * KNOT, 0.3062 * KNOT, 0.15
+    x0 = np.array([20.0, 55.0, 95.0])
+    n_mc = 400
+    hit_m = np.zeros(3)
+    hit_p = np.zeros(3)
+    hit_inv = 0
+    for _ in range(n_mc):
+        y = b0 + b1 * x + sig * rng.standard_normal(x.size)
+        c = L.calibrate(x, y)
+        lo, hi = c.band(x0)
+        hit_m += (lo <= b0 + b1 * x0) & (b0 + b1 * x0 <= hi)
+        ynew = b0 + b1 * x0 + sig * rng.standard_normal(3)
+        plo, phi = c.band(x0, prediction=True)
+        hit_p += (plo <= ynew) & (ynew <= phi)
+        hit_inv += c.reading_for(b0 + b1 * 55.0).covers(55.0)
+    tol = 3 * math.sqrt(0.95 * 0.05 / n_mc)
+    assert np.all(np.abs(hit_m / n_mc - 0.95) <= tol)
+    assert np.all(np.abs(hit_p / n_mc - 0.95) <= tol)
+    assert abs(hit_inv / n_mc - 0.95) <= tol
+
+
+def test_inverse_use_round_trip():
+    c = L.calibrate(MR_X, MR_Y)
+    e = c.reading_for(float(c(1.3)))
+    assert e.value == pytest.approx(1.3, rel=1e-12)
+    assert e.std == pytest.approx(float(c.se_mean(1.3)) / c.beta1.value, rel=1e-12)
+    assert c.stw(1.3).value == pytest.approx(float(c(1.3)))
+
+
+# Seed 000, Table 3 (extreme Kenyon 10-s counts per run) — the only numeric run data the seed copy
+# keeps; its Table 1 data, computed currents and the fitted equation (3) are omitted from the copy.
+# (run, high count, low count, difference in counts, difference in knots)
+SEED000_TABLE3 = [
+    ("1N", 187, 131, 56, 1.72), ("1S", 217, 183, 34, 1.05), ("1E", 211, 162, 49, 1.51),
+    ("1W", 180, 145, 35, 1.08), ("2N", 332, 325, 7, 0.22), ("2S", 344, 331, 13, 0.40),
+    ("2E", 351, 332, 19, 0.58), ("2W", 334, 317, 17, 0.52), ("3N", 486, 475, 11, 0.34),
+    ("3S", 518, 464, 54, 1.66), ("4N", 638, 630, 8, 0.25), ("4S", 655, 610, 45, 1.38),
+    ("5N", 839, 829, 10, 0.31), ("5S", 850, 819, 31, 0.95), ("6N", 947, 932, 15, 0.46),
+    ("6S-1", 950, 918, 32, 0.98), ("6S-2", 955, 927, 28, 0.86),
+]
+
+
+def test_seed000_table3_is_consistent_with_the_reported_slope():
+    """The knots column of Table 3 converts 10-s count differences with the calibration slope:
+    regressing it on the count difference gives β₁ whose 95 % interval contains the seed's
+    0.3062 kn/(count/s) (= 0.03062 kn per 10-s count) and excludes the nominal 0.3; β₀ ≈ 0."""
+    hi = np.array([r[1] for r in SEED000_TABLE3], float)
+    lo = np.array([r[2] for r in SEED000_TABLE3], float)
+    dc = np.array([r[3] for r in SEED000_TABLE3], float)
+    dk = np.array([r[4] for r in SEED000_TABLE3], float)
+    assert np.all(hi - lo == dc)
+    rate = L.counts_to_rate(dc, 10.0)  # count/s
+    c = L.calibrate(rate, dk * KNOT)
+    slope_seed = 0.3062 * KNOT  # m/s per count/s
+    assert c.beta1.covers(slope_seed)
+    assert not c.beta1.covers(0.3 * KNOT)
+    assert c.beta0.covers(0.0)
+    assert c.r2 > 0.999
+    assert np.max(np.abs(dk - 0.03062 * dc)) < 0.01  # within the table's 0.01-kn rounding
+
+
+def test_running_average_and_smoothing_study_white_noise():
+    rng = np.random.default_rng(3)
+    x = rng.normal(500.0, 10.0, 4000)
+    ra = L.running_average(x, 3)
+    assert np.allclose(ra, np.convolve(x, np.ones(3) / 3, mode="valid"))
+    t = 20.0 * np.arange(x.size)  # Kenyon: a 10-s count every 20 s
+    st = L.smoothing_study(t, x, (1, 2, 3, 6))
+    assert st.times[2][0] == t[2] and st.series[3].size == x.size - 5
+    # independent cycles: std falls as 1/√k
+    assert np.allclose(st.std, st.std_white, rtol=0.08)
+    assert np.all(np.abs(st.std - 10.0 / np.sqrt(st.k)) < 4 * st.std_se + 0.05)
+
+
+def test_smoothing_study_periodic_variation_attenuation():
+    """A helm-induced oscillation (seed 000: period 80–120 s) sampled every 20 s: the k-cycle running
+    mean multiplies its amplitude by |sin(kπΔ/T)/(k sin(πΔ/T))| (Dirichlet kernel) — e.g. 0.667 for
+    k = 3, T = 120 s (hardly better than the 1/√3 = 0.577 it gives white noise) and 0 for kΔ = T."""
+    dt, T = 20.0, 120.0
+    t = dt * np.arange(3000)
+    x = 900.0 + 15.0 * np.sin(2 * math.pi * t / T + 0.3)
+    st = L.smoothing_study(t, x, (1, 2, 3, 6))
+    expect = np.abs(np.sin(st.k * math.pi * dt / T) / (st.k * np.sin(math.pi * dt / T)))
+    assert np.allclose(st.std / st.std[0], expect, atol=2e-3)
+    assert expect[2] == pytest.approx(2.0 / 3.0) and expect[3] < 1e-12

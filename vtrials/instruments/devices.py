@@ -1,0 +1,720 @@
+"""The instruments: what each device measures (its measurand at its site), its own physics, and the
+chain of error parts from its catalogue entry.
+
+Every device works on truth chunks (dicts of equal-length arrays at the simulation rate, as
+:func:`vtrials.truth.ship_columns` gives them), streaming: ``reset(rng)`` then ``process(cols)``
+any number of times; it returns the samples it emits per channel, in SI units, on its own clock.
+``drawn()`` lists the error parameters actually drawn (for the truth file); ``meta()`` what the
+trials team knows (nominal calibration, surveyed position, rate) — the record carries it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ..units import DEG, KNOT, RPM
+from . import parts as P
+from .kinematics import SiteKinematics
+
+UNIT_FACTORS = {"m": 1.0, "deg": DEG, "kn": KNOT, "m/s": 1.0, "rpm": RPM, "N m": 1.0, "N": 1.0, "1": 1.0,
+                "SI": 1.0, "m/s2": 1.0, "deg/s": DEG}
+COMMON_KEYS = {"kind", "source", "units", "rate_hz", "bias", "scale", "gauss_markov", "random_walk", "noise",
+               "resolution", "range", "latency_s", "hold_s", "update_s", "dropout_p", "clock_offset_s",
+               "misalignment_deg"}
+
+
+class SpecError(ValueError):
+    """An instrument spec is wrong (the suite loader turns it into an InputError naming file and field)."""
+
+    def __init__(self, field: str, problem: str):
+        self.field = field
+        self.problem = problem
+        super().__init__(f"{field}: {problem}")
+
+
+def _dist(spec: dict, key: str, f: float = 1.0) -> tuple[float, float]:
+    v = spec.get(key)
+    if v is None:
+        return 0.0, 0.0
+    if isinstance(v, dict):
+        return float(v.get("mean", 0.0)) * f, float(v.get("sd", 0.0)) * f
+    return 0.0, float(v) * f
+
+
+def value_chain(spec: dict, f: float, n_axes: int | None = None, *, sampling: list | None = None,
+                full_scale: float | None = None) -> P.Chain:
+    """The standard chain of a spec: sampling stage, bias/scale, Gauss–Markov, random walk, white
+    noise, saturation, quantization, dropouts, latency, clock offset (parts.py's recommended order).
+    ``f`` converts the spec's units to SI; ``*_fs`` entries are fractions of ``full_scale``."""
+    parts: list[P.Part] = list(sampling) if sampling is not None else []
+    if sampling is None and "rate_hz" in spec:
+        parts.append(P.Resample(float(spec["rate_hz"])))
+    if spec.get("misalignment_deg") and n_axes == 3:
+        parts.append(P.Misalignment(sd=float(spec["misalignment_deg"]) * DEG, n_axes=3))
+    sm, ss = _dist(spec, "scale")
+    if ss or sm:
+        parts.append(P.ScaleFactor(sm, ss, n_axes=n_axes))
+    bm, bs = _dist(spec, "bias", f)
+    if full_scale is not None and "bias_fs" in spec:
+        fm, fs = _dist(spec, "bias_fs", full_scale)
+        bm, bs = bm + fm, math.hypot(bs, fs)
+    if bs or bm:
+        parts.append(P.Bias(bm, bs, n_axes=n_axes))
+    gm = spec.get("gauss_markov")
+    if gm:
+        parts.append(P.GaussMarkov(float(gm["tau_s"]), float(gm["sd"]) * f, n_axes=n_axes))
+    if spec.get("random_walk"):
+        parts.append(P.RandomWalk(float(spec["random_walk"]) * f, n_axes=n_axes))
+    noise = float(spec.get("noise", 0.0)) * f
+    if full_scale is not None and "noise_fs" in spec:
+        noise = math.hypot(noise, float(spec["noise_fs"]) * full_scale)
+    if noise:
+        parts.append(P.WhiteNoise(noise, n_axes=n_axes))
+    if spec.get("range"):
+        lo, hi = spec["range"]
+        parts.append(P.Saturation(float(lo) * f, float(hi) * f))
+    res = float(spec.get("resolution", 0.0)) * f
+    if full_scale is not None and "resolution_fs" in spec:
+        res = float(spec["resolution_fs"]) * full_scale
+    if res:
+        parts.append(P.Quantization(res, n_axes=n_axes))
+    if spec.get("dropout_p"):
+        parts.append(P.Dropouts(p=float(spec["dropout_p"])))
+    if spec.get("latency_s"):
+        parts.append(P.Latency(float(spec["latency_s"])))
+    if spec.get("clock_offset_s"):
+        parts.append(P.ClockOffset(sd=float(spec["clock_offset_s"])))
+    return P.Chain(parts)
+
+
+class Device:
+    """Base class: a named instrument at a site, with a catalogue spec (merged with overrides)."""
+
+    kind = "device"
+    extra_keys: set[str] = set()
+    channels: dict[str, tuple[str, str]] = {}
+
+    def __init__(self, name: str, spec: dict, site_name: str, site: np.ndarray, team: dict):
+        unknown = set(spec) - COMMON_KEYS - self.extra_keys
+        if unknown:
+            raise SpecError(sorted(unknown)[0], f"not a {self.kind} parameter (allowed: "
+                                                f"{', '.join(sorted(COMMON_KEYS | self.extra_keys))})")
+        units = spec.get("units", "SI")
+        if units not in UNIT_FACTORS:
+            raise SpecError("units", f"{units!r} unknown (allowed: {', '.join(UNIT_FACTORS)})")
+        self.name, self.spec, self.site_name = name, spec, site_name
+        self.site = np.asarray(site, dtype=float)
+        self.f = UNIT_FACTORS[units]
+        self.team = team
+        self.build()
+
+    def build(self) -> None:
+        self.chain = value_chain(self.spec, self.f, self.n_axes)
+
+    n_axes: int | None = None
+
+    def reset(self, rng: np.random.Generator) -> None:
+        self.chain.reset(rng)
+
+    def measurand(self, kin: SiteKinematics, cols: dict) -> np.ndarray:
+        raise NotImplementedError
+
+    def outputs(self, t: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
+        names = list(self.channels)
+        if y.ndim == 1:
+            return {names[0]: y}
+        return {n: y[:, k] for k, n in enumerate(names)}
+
+    def process(self, cols: dict) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        kin = SiteKinematics(cols, self.site)
+        t, y = self.chain.process(cols["t"], self.measurand(kin, cols))
+        return t, self.outputs(t, y)
+
+    def drawn(self) -> dict:
+        return {"chain": self.chain.drawn()}
+
+    def meta(self) -> dict:
+        return {"kind": self.kind, "site": self.site_name, "surveyed_position_m": self.site.tolist(),
+                "nominal_rate_hz": float(self.spec.get("rate_hz", 0.0)), "source": self.spec.get("source", "")}
+
+
+def _wrap2pi(a):
+    return np.mod(a, 2 * math.pi)
+
+
+@nb.njit(cache=True)
+def first_order_lag(t, x, tau, y0, t0):
+    """y' = (x − y)/τ(t) integrated exactly for piecewise-constant input between samples; returns the
+    output at the sample times and the final state. τ may vary sample to sample."""
+    y = np.empty_like(x)
+    yk = y0
+    tl = t0
+    for k in range(t.size):
+        yk += (x[k] - yk) * (1.0 - math.exp(-(t[k] - tl) / tau[k]))
+        tl = t[k]
+        y[k] = yk
+    return y, yk
+
+
+# ---------------------------------------------------------------------------------------- navigation
+class GNSS(Device):
+    """Satellite positioning at the antenna: north, east (time-correlated errors) and velocity."""
+
+    kind = "gnss"
+    extra_keys = {"velocity_noise_mps"}
+    channels = {"north": ("m", "antenna position north"), "east": ("m", "antenna position east"),
+                "sog": ("m s-1", "speed over ground"), "cog": ("rad", "course over ground (0..2π)")}
+    n_axes = 4
+
+    def build(self):
+        s, f = self.spec, self.f
+        gm = s.get("gauss_markov", {"sd": 0.0, "tau_s": 1.0})
+        n = float(s.get("noise", 0.0)) * f
+        vn = float(s.get("velocity_noise_mps", 0.0))
+        parts = [P.Resample(float(s["rate_hz"])),
+                 P.GaussMarkov(float(gm["tau_s"]), [float(gm["sd"]) * f] * 2 + [0.0, 0.0], n_axes=4),
+                 P.WhiteNoise([n, n, vn, vn], n_axes=4)]
+        if s.get("dropout_p"):
+            parts.append(P.Dropouts(p=float(s["dropout_p"])))
+        self.chain = P.Chain(parts)
+
+    def measurand(self, kin, cols):
+        p = kin.position()
+        v = kin.velocity_world()
+        return np.column_stack([p[:, 0], p[:, 1], v[:, 0], v[:, 1]])
+
+    def outputs(self, t, y):
+        return {"north": y[:, 0], "east": y[:, 1], "sog": np.hypot(y[:, 2], y[:, 3]),
+                "cog": _wrap2pi(np.arctan2(y[:, 3], y[:, 2]))}
+
+
+def two_range_fix(r1, r2, a, b, side: float):
+    """Position from ranges r1, r2 [m] to stations a, b (north, east); the intersection on the given
+    side of the baseline a→b (+1 starboard of a→b, −1 port). NaN where the circles do not meet."""
+    a = np.asarray(a, float)
+    b = np.asarray(b, float)
+    d = np.linalg.norm(b - a)
+    ex = (b - a) / d
+    ey = np.array([-ex[1], ex[0]])  # 90° clockwise in north-east axes: starboard of a→b
+    x = (r1 ** 2 - r2 ** 2 + d ** 2) / (2 * d)
+    h2 = r1 ** 2 - x ** 2
+    h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
+    pts = a + np.outer(x, ex) + side * np.outer(h, ey)
+    return pts[:, 0], pts[:, 1]
+
+
+class RangeRadar(Device):
+    """Range–range pulse radar (Falcon, seed 002): ranges from the ship's antenna to two shore
+    transponders, and the position fix the system computes from them and the surveyed baseline.
+    The fix error grows as the range lines' crossing angle narrows (geometric dilution)."""
+
+    kind = "range_radar"
+    channels = {"range_a": ("m", "range to transponder A"), "range_b": ("m", "range to transponder B"),
+                "north": ("m", "position fix north"), "east": ("m", "position fix east"),
+                "crossing_angle": ("rad", "angle between the two range lines at the fix")}
+    n_axes = 2
+
+    def build(self):
+        site = self.team.get("site", {})
+        tr = site.get("transponders")
+        if not tr or len(tr) < 2:
+            raise SpecError("transponders", "a range-range radar needs two shore transponders in the trial "
+                                            "site ([site] transponders = [[north, east], [north, east]])")
+        self.a, self.b = np.array(tr[0], float), np.array(tr[1], float)
+        self.side = float(site.get("transponder_side", 1.0))
+        self.chain = value_chain(self.spec, self.f, 2)
+
+    def measurand(self, kin, cols):
+        p = kin.position()[:, :2]
+        return np.column_stack([np.linalg.norm(p - self.a, axis=1), np.linalg.norm(p - self.b, axis=1)])
+
+    def outputs(self, t, y):
+        n, e = two_range_fix(y[:, 0], y[:, 1], self.a, self.b, self.side)
+        ua = np.column_stack([n - self.a[0], e - self.a[1]])
+        ub = np.column_stack([n - self.b[0], e - self.b[1]])
+        cosg = np.sum(ua * ub, axis=1) / (np.linalg.norm(ua, axis=1) * np.linalg.norm(ub, axis=1))
+        return {"range_a": y[:, 0], "range_b": y[:, 1], "north": n, "east": e,
+                "crossing_angle": np.arccos(np.clip(cosg, -1, 1))}
+
+    def meta(self):
+        m = super().meta()
+        m.update({"transponder_a": self.a.tolist(), "transponder_b": self.b.tolist(), "fix_side": self.side})
+        return m
+
+
+class AcousticRange(Device):
+    """Acoustic range: a pinger on the hull every 1–4 s, slant ranges to hydrophones on the bottom
+    (seed 002); the fix is the least-squares intersection of the horizontal ranges."""
+
+    kind = "acoustic_range"
+    channels = {"north": ("m", "position fix north"), "east": ("m", "position fix east")}
+
+    def build(self):
+        site = self.team.get("site", {})
+        hy = site.get("hydrophones")
+        if not hy or len(hy) < 2:
+            raise SpecError("hydrophones", "an acoustic range needs at least two bottom hydrophones in the trial "
+                                           "site ([site] hydrophones = [[north, east], ...])")
+        self.h = np.array(hy, float)
+        self.depth = float(site.get("water_depth_m", 100.0))
+        self.side = float(site.get("hydrophone_side", 1.0))
+        a, b = self.spec.get("update_s", [1.0, 4.0])
+        self.n_axes = len(self.h)
+        parts = [P.IrregularUpdates(float(a), float(b), method="linear")]
+        self.chain = value_chain({k: v for k, v in self.spec.items() if k != "rate_hz"}, self.f, self.n_axes,
+                                 sampling=parts)
+
+    def measurand(self, kin, cols):
+        p = kin.position()
+        dz = self.depth - p[:, 2]
+        return np.column_stack([np.sqrt(np.sum((p[:, :2] - hp) ** 2, axis=1) + dz ** 2) for hp in self.h])
+
+    def outputs(self, t, y):
+        # horizontal ranges from slant ranges (the pinger's depth is known), then the two-station fix
+        # with the first two hydrophones
+        r = np.sqrt(np.maximum(y ** 2 - self.depth ** 2, 0.0))
+        n, e = two_range_fix(r[:, 0], r[:, 1], self.h[0], self.h[1], self.side)
+        return {"north": n, "east": e}
+
+    def meta(self):
+        m = super().meta()
+        m.update({"hydrophones": self.h.tolist(), "hydrophone_depth_m": self.depth})
+        return m
+
+
+class Loran(Device):
+    """LORAN-C receiver (seed 000): position fixes at irregular 15–60 s intervals with a slowly varying
+    ground-wave bias; the speed-over-ground display is the average between successive fixes."""
+
+    kind = "loran"
+    channels = {"north": ("m", "LORAN fix north"), "east": ("m", "LORAN fix east"),
+                "sog": ("m s-1", "displayed speed over ground: distance between the last two fixes / their interval"),
+                "cog": ("rad", "displayed course over ground (0..2π)")}
+    n_axes = 2
+
+    def build(self):
+        a, b = self.spec["update_s"]
+        self.chain = value_chain({k: v for k, v in self.spec.items() if k != "rate_hz"}, self.f, 2,
+                                 sampling=[P.IrregularUpdates(float(a), float(b), method="linear")])
+
+    def reset(self, rng):
+        super().reset(rng)
+        self._last = None
+
+    def measurand(self, kin, cols):
+        return kin.position()[:, :2]
+
+    def outputs(self, t, y):
+        n, e = y[:, 0], y[:, 1]
+        tt = t
+        if self._last is not None:
+            tt = np.concatenate([[self._last[0]], t])
+            n = np.concatenate([[self._last[1]], n])
+            e = np.concatenate([[self._last[2]], e])
+        dn, de, dt = np.diff(n), np.diff(e), np.diff(tt)
+        sog = np.hypot(dn, de) / dt if dt.size else np.zeros(0)
+        cog = _wrap2pi(np.arctan2(de, dn)) if dt.size else np.zeros(0)
+        if self._last is None and t.size:
+            sog = np.concatenate([[np.nan], sog])
+            cog = np.concatenate([[np.nan], cog])
+        if t.size:
+            self._last = (t[-1], y[-1, 0], y[-1, 1])
+        return {"north": y[:, 0], "east": y[:, 1], "sog": sog, "cog": cog}
+
+
+# ------------------------------------------------------------------------------------- speed logs
+class Knotmeter(Device):
+    """Impeller knotmeter (Kenyon, seed 000): one pulse per revolution; the impeller turns with the
+    water speed at the sensor, reduced by the hull boundary layer (deficit d), against bearing
+    friction (it does not start below a break-away speed and slips by a constant amount above it),
+    and under-reads when the flow meets it at an angle (rolling at low speed: the roll rate times the
+    sensor's depth below the roll axis adds cross-flow; beyond the stall angle the response drops).
+    Counts are accumulated over a 10-s window every 20 s; the display shows counts/10 s × the nominal
+    0.3 kn per count/s and holds it for the cycle.
+
+    Pulse rate f = (1 + s)·((1 − d)·u_s − V₀)·c(θ)/k_nom above break-away (else 0), with u_s the
+    axial water speed at the sensor, V₀ the friction slip, c(θ) = 1/(1 + (θ/θ_stall)⁴), k_nom the
+    nominal kn per count/s. So displayed D = (1 + s)((1 − d) V − V₀) for steady straight flow, and the
+    true calibration is STW = V₀/(1 − d) + D/((1 + s)(1 − d))."""
+
+    kind = "knotmeter"
+    extra_keys = {"nominal_kn_per_count_s", "count_window_s", "cycle_s", "breakaway_kn", "boundary_layer_deficit",
+                  "roll_stall_deg", "slip_kn"}
+    channels = {"counts": ("1", "impeller pulses counted in the window"),
+                "speed": ("m s-1", "displayed speed: counts per second × the nominal calibration")}
+
+    def build(self):
+        s = self.spec
+        self.k_nom = float(s["nominal_kn_per_count_s"]) * KNOT  # m/s per (count/s)
+        self.window = float(s.get("count_window_s", 10.0))
+        self.cycle = float(s.get("cycle_s", 20.0))
+        self.stall = float(s.get("roll_stall_deg", 20.0)) * DEG
+        self.chain = P.Chain([P.WindowAverage(self.window, period=self.cycle, output="count",
+                                              pulses_per_unit=1.0)])
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        s = self.spec
+        br = s.get("breakaway_kn", {"lo": 0.0, "hi": 0.0})
+        self.v_break = float(r1.uniform(float(br["lo"]), float(br["hi"]))) * KNOT
+        dm, ds = _dist(s, "boundary_layer_deficit")
+        self.d = dm + ds * float(r1.standard_normal())
+        sm, ss = _dist(s, "scale")
+        self.s = sm + ss * float(r1.standard_normal())
+        slm, sls = _dist(s, "slip_kn", KNOT)
+        self.v0 = slm + sls * float(r1.standard_normal())
+        self.chain.reset(r2)
+
+    def rate(self, kin) -> np.ndarray:
+        """True pulse rate [count/s] at the sensor."""
+        v = kin.velocity_body(through_water=True)
+        u = v[:, 0]
+        cross = np.hypot(v[:, 1], v[:, 2])
+        theta = np.arctan2(cross, np.abs(u))
+        c = 1.0 / (1.0 + (theta / self.stall) ** 4)
+        w = (1.0 - self.d) * u
+        f = (1.0 + self.s) * np.maximum(w - self.v0, 0.0) * c / self.k_nom
+        return np.where(w > self.v_break, f, 0.0)
+
+    def process(self, cols):
+        kin = SiteKinematics(cols, self.site)
+        t, counts = self.chain.process(cols["t"], self.rate(kin))
+        return t, {"counts": counts, "speed": counts / self.window * self.k_nom}
+
+    def true_calibration(self) -> tuple[float, float]:
+        """(intercept [m/s], slope) of STW = a + b·displayed in steady straight flow above break-away."""
+        return self.v0 / (1.0 - self.d), 1.0 / ((1.0 + self.s) * (1.0 - self.d))
+
+    def drawn(self):
+        a, b = self.true_calibration()
+        return {"breakaway_mps": self.v_break, "boundary_layer_deficit": self.d, "scale": self.s,
+                "slip_mps": self.v0, "true_calibration_intercept_mps": a, "true_calibration_slope": b,
+                "chain": self.chain.drawn()}
+
+    def meta(self):
+        m = super().meta()
+        m.update({"nominal_calibration_mps_per_count_s": self.k_nom, "count_window_s": self.window,
+                  "cycle_s": self.cycle})
+        return m
+
+
+class EMLog(Device):
+    """Electromagnetic log: water speed at the sensor along the ship, with calibration scale and offset
+    errors, noise and resolution; no output astern (it shows zero: seed 002)."""
+
+    kind = "em_log"
+    channels = {"speed": ("m s-1", "EM log speed through the water (zero astern)")}
+
+    def measurand(self, kin, cols):
+        return kin.velocity_body(through_water=True)[:, 0]
+
+    def outputs(self, t, y):
+        return {"speed": np.maximum(y, 0.0)}
+
+
+class DopplerLog(Device):
+    """Doppler log (water-track): surge and sway through the water at the transducer; its
+    misalignment about the vertical rotates the pair and biases the sideslip (seed 001)."""
+
+    kind = "doppler_log"
+    channels = {"u": ("m s-1", "surge through the water at the transducer"),
+                "v": ("m s-1", "sway through the water at the transducer")}
+    n_axes = 2
+
+    def build(self):
+        sp = {k: v for k, v in self.spec.items() if k != "misalignment_deg"}
+        self.chain = value_chain(sp, self.f, 2)
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        self.eps = float(r1.standard_normal()) * float(self.spec.get("misalignment_deg", 0.0)) * DEG
+        self.chain.reset(r2)
+
+    def measurand(self, kin, cols):
+        v = kin.velocity_body(through_water=True)
+        c, s = math.cos(self.eps), math.sin(self.eps)
+        return np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1]])
+
+    def drawn(self):
+        return {"misalignment_rad": self.eps, "chain": self.chain.drawn()}
+
+
+# ------------------------------------------------------------------------------------ attitude, IMU
+class Heading(Device):
+    """Gyrocompass: heading with bias, slow drift, noise, resolution and a small lag; output 0..2π."""
+
+    kind = "heading"
+    channels = {"heading": ("rad", "gyrocompass heading (0..2π, clockwise from north)")}
+
+    def measurand(self, kin, cols):
+        return cols["heading"]
+
+    def outputs(self, t, y):
+        return {"heading": _wrap2pi(y)}
+
+
+class Attitude(Device):
+    """Vertical gyro: roll and pitch."""
+
+    kind = "attitude"
+    channels = {"roll": ("rad", "roll (+ starboard down)"), "pitch": ("rad", "pitch (+ bow up)")}
+    n_axes = 2
+
+    def measurand(self, kin, cols):
+        return np.column_stack([cols["roll"], cols["pitch"]])
+
+
+class IMU(Device):
+    """Strapdown motion package at its site: triaxial accelerometers (specific force, including the
+    lever-arm centripetal and tangential terms) and rate gyros, each with bias, bias instability,
+    noise, scale-factor error and a common misalignment."""
+
+    kind = "imu"
+    extra_keys = {"accel_bias_ug", "accel_gauss_markov_ug", "accel_noise_mps2", "accel_scale", "gyro_bias_dph",
+                  "gyro_gauss_markov_dph", "gyro_noise_dps", "gyro_scale"}
+    channels = {"ax": ("m s-2", "specific force x"), "ay": ("m s-2", "specific force y"),
+                "az": ("m s-2", "specific force z (≈ −g at rest)"), "p": ("rad s-1", "roll rate"),
+                "q": ("rad s-1", "pitch rate"), "r": ("rad s-1", "yaw rate")}
+    n_axes = 6
+
+    def build(self):
+        s = self.spec
+        ug = 9.80665e-6
+        dph = DEG / 3600.0
+        am, asd = _dist(s, "accel_bias_ug", ug)
+        gm_, gsd = _dist(s, "gyro_bias_dph", dph)
+        agm = s.get("accel_gauss_markov_ug", {"sd": 0.0, "tau_s": 100.0})
+        ggm = s.get("gyro_gauss_markov_dph", {"sd": 0.0, "tau_s": 100.0})
+        sa = s.get("accel_scale", {"mean": 0.0, "sd": 0.0})
+        sg = s.get("gyro_scale", {"mean": 0.0, "sd": 0.0})
+        self.acc = P.Chain([P.Misalignment(sd=float(s.get("misalignment_deg", 0.0)) * DEG, n_axes=3),
+                            P.ScaleFactor(sa["mean"], sa["sd"], n_axes=3), P.Bias(am, asd, n_axes=3),
+                            P.GaussMarkov(float(agm["tau_s"]), float(agm["sd"]) * ug, n_axes=3),
+                            P.WhiteNoise(float(s.get("accel_noise_mps2", 0.0)), n_axes=3)])
+        self.gyr = P.Chain([P.Misalignment(sd=float(s.get("misalignment_deg", 0.0)) * DEG, n_axes=3),
+                            P.ScaleFactor(sg["mean"], sg["sd"], n_axes=3), P.Bias(gm_, gsd, n_axes=3),
+                            P.GaussMarkov(float(ggm["tau_s"]), float(ggm["sd"]) * dph, n_axes=3),
+                            P.WhiteNoise(float(s.get("gyro_noise_dps", 0.0)) * DEG, n_axes=3)])
+        self.clock = P.Resample(float(s["rate_hz"]))
+        self.chain = P.Chain([self.clock])
+
+    def reset(self, rng):
+        r1, r2, r3 = rng.spawn(3)
+        self.clock.reset(r1)
+        self.acc.reset(r2)
+        self.gyr.reset(r3)
+
+    def process(self, cols):
+        kin = SiteKinematics(cols, self.site)
+        t, y = self.clock.process(cols["t"], np.column_stack([kin.specific_force(), kin.omega]))
+        _, a = self.acc.process(t, y[:, :3])
+        _, w = self.gyr.process(t, y[:, 3:])
+        return t, {"ax": a[:, 0], "ay": a[:, 1], "az": a[:, 2], "p": w[:, 0], "q": w[:, 1], "r": w[:, 2]}
+
+    def drawn(self):
+        return {"clock": self.clock.drawn(), "accelerometers": self.acc.drawn(), "gyros": self.gyr.drawn()}
+
+
+class Anemometer(Device):
+    """Anemometer on a mast: apparent wind at the site (true wind at its height minus the site's own
+    velocity over ground — the motion-induced part from the mast's lever arm included), distorted by
+    the airwake of hull and superstructure (a speed factor 1 + Σ aₖ cos kγ + bₖ sin kγ and a direction
+    offset Σ cₖ sin kγ of the relative wind angle γ), lagged by the cups' distance constant
+    (first-order, time constant = distance constant / wind speed) and cut below the start threshold;
+    vane alignment error, noise and resolution."""
+
+    kind = "anemometer"
+    extra_keys = {"distance_constant_m", "start_threshold_mps", "speed_bias_kn", "speed_resolution_kn",
+                  "direction_alignment_deg", "direction_noise_deg", "direction_resolution_deg", "airwake_speed",
+                  "airwake_direction_deg"}
+    channels = {"speed": ("m s-1", "relative wind speed"),
+                "angle": ("rad", "relative wind angle it comes from, off the bow, + to starboard (0..2π)")}
+
+    def build(self):
+        s = self.spec
+        self.dc = float(s.get("distance_constant_m", 0.0))
+        self.start = float(s.get("start_threshold_mps", 0.0))
+        self.ws = np.asarray(s.get("airwake_speed", [0.0]), float)
+        self.wd = np.asarray(s.get("airwake_direction_deg", [0.0]), float) * DEG
+        bm, bs = _dist(s, "speed_bias_kn", KNOT)
+        am, asd = _dist(s, "direction_alignment_deg", DEG)
+        self.clock = P.Resample(float(s["rate_hz"]))
+        spd = [P.Bias(bm, bs)]
+        if s.get("speed_resolution_kn"):
+            spd.append(P.Quantization(float(s["speed_resolution_kn"]) * KNOT))
+        drn = [P.Bias(am, asd)]
+        if s.get("direction_noise_deg"):
+            drn.append(P.WhiteNoise(float(s["direction_noise_deg"]) * DEG))
+        if s.get("direction_resolution_deg"):
+            drn.append(P.Quantization(float(s["direction_resolution_deg"]) * DEG))
+        self.spd = P.Chain(spd)
+        self.dir = P.Chain(drn)
+        self.chain = P.Chain([self.clock])
+
+    def reset(self, rng):
+        r1, r2, r3 = rng.spawn(3)
+        self.clock.reset(r1)
+        self.spd.reset(r2)
+        self.dir.reset(r3)
+        self._lag = None
+        self._tlast = None
+
+    def airwake(self, speed, gamma):
+        k = np.arange(1, (len(self.ws) - 1) // 2 + 1)
+        fac = 1.0 + self.ws[0] + sum(self.ws[2 * i - 1] * np.cos(i * gamma) + self.ws[2 * i] * np.sin(i * gamma)
+                                     for i in k)
+        off = self.wd[0] + sum(self.wd[i] * np.sin(i * gamma) for i in range(1, len(self.wd)))
+        return speed * fac, gamma + off
+
+    def process(self, cols):
+        kin = SiteKinematics(cols, self.site)
+        speed, gamma = kin.apparent_wind()
+        speed, gamma = self.airwake(speed, gamma)
+        t = cols["t"]
+        if self.dc > 0.0 and t.size:
+            # cups respond over their distance constant: a first-order lag with τ = d / U
+            y0 = speed[0] if self._lag is None else self._lag
+            t0 = t[0] if self._tlast is None else self._tlast
+            speed, self._lag = first_order_lag(t, speed, self.dc / np.maximum(speed, 0.1), y0, t0)
+            self._tlast = t[-1]
+        speed = np.where(speed < self.start, 0.0, speed)
+        tt, y = self.clock.process(t, np.column_stack([speed, np.cos(gamma), np.sin(gamma)]))
+        _, sp = self.spd.process(tt, y[:, 0])
+        _, ang = self.dir.process(tt, np.arctan2(y[:, 2], y[:, 1]))
+        return tt, {"speed": np.maximum(sp, 0.0), "angle": _wrap2pi(ang)}
+
+    def drawn(self):
+        return {"clock": self.clock.drawn(), "speed": self.spd.drawn(), "direction": self.dir.drawn()}
+
+    def meta(self):
+        m = super().meta()
+        m.update({"distance_constant_m": self.dc, "start_threshold_mps": self.start})
+        return m
+
+
+# ------------------------------------------------------------------------------------- machinery
+class ShaftDevice(Device):
+    """Base of the per-shaft instruments (spec key 'shaft' in the suite names the shaft)."""
+
+    full_scale_key = "full_scale"
+
+    def __init__(self, name, spec, site_name, site, team, index: int, full_scale: float | None):
+        self.index = index
+        self.full_scale = full_scale
+        super().__init__(name, spec, site_name, site, team)
+
+    def build(self):
+        if any(k.endswith("_fs") for k in self.spec) and not self.full_scale:
+            raise SpecError("full_scale", f"{self.kind} errors are given in % of full scale: the suite must give "
+                                          f"its full_scale")
+        self.chain = value_chain(self.spec, self.f, None, full_scale=self.full_scale)
+
+    def meta(self):
+        m = super().meta()
+        m.update({"shaft_index": self.index, "full_scale": self.full_scale})
+        return m
+
+
+class ShaftTorque(ShaftDevice):
+    """Strain-gauge torsionmeter: the torque the shaft transmits to the propeller."""
+
+    kind = "shaft_torque"
+    extra_keys = {"bias_fs", "noise_fs", "resolution_fs"}
+    channels = {"torque": ("N m", "shaft torque")}
+
+    def measurand(self, kin, cols):
+        return cols[f"prop_torque_{self.index}"]
+
+
+class ShaftSpeed(ShaftDevice):
+    """Shaft revolution counter (reflective strips read by an infrared sensor)."""
+
+    kind = "shaft_rpm"
+    extra_keys = {"strips"}
+    channels = {"rps": ("s-1", "shaft speed (revolutions per second)")}
+
+    def measurand(self, kin, cols):
+        return cols[f"shaft_n_{self.index}"]
+
+
+class Thrustmeter(ShaftDevice):
+    """Thrust-bearing load cells: the propeller thrust plus a static load (submergence, weight,
+    inclination) that the team must subtract; the team knows its nominal value."""
+
+    kind = "thrust"
+    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "static_load_fs"}
+    channels = {"thrust": ("N", "thrust-bearing load (static load included)")}
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        m, s = _dist(self.spec, "static_load_fs", self.full_scale or 0.0)
+        self.static_nominal = m
+        self.static = m + s * float(r1.standard_normal())
+        self.chain.reset(r2)
+
+    def measurand(self, kin, cols):
+        return cols[f"thrust_{self.index}"] + self.static
+
+    def drawn(self):
+        return {"static_load_N": self.static, "chain": self.chain.drawn()}
+
+    def meta(self):
+        m = super().meta()
+        m["nominal_static_load_N"] = self.static_nominal
+        return m
+
+
+class PitchIndicator(ShaftDevice):
+    """Controllable-pitch indicator whose zero drifts with the hub-oil temperature, which rises with
+    the power delivered (first-order, time constant oil_temperature_tau_s) — seed 002."""
+
+    kind = "pitch_indicator"
+    extra_keys = {"oil_temperature_rise_K", "oil_temperature_tau_s", "bias_per_K"}
+    channels = {"pitch": ("1", "indicated pitch ratio")}
+
+    def reset(self, rng):
+        super().reset(rng)
+        self._T = 0.0
+        self._tl = None
+
+    def measurand(self, kin, cols):
+        s = self.spec
+        P_ = 2 * math.pi * cols[f"shaft_n_{self.index}"] * cols[f"prop_torque_{self.index}"]
+        pmax = float(self.team.get("max_power_W", [1.0])[self.index])
+        rise = float(s.get("oil_temperature_rise_K", 0.0))
+        tau = float(s.get("oil_temperature_tau_s", 1.0))
+        t = cols["t"]
+        if t.size == 0:
+            return cols[f"pitch_{self.index}"]
+        t0 = t[0] if self._tl is None else self._tl
+        T, self._T = first_order_lag(t, rise * np.abs(P_) / pmax, np.full(t.size, tau), self._T, t0)
+        self._tl = t[-1]
+        return cols[f"pitch_{self.index}"] + float(s.get("bias_per_K", 0.0)) * T
+
+
+class RudderAngle(Device):
+    """Rudder angle synchro (per rudder: spec key 'rudder' in the suite)."""
+
+    kind = "rudder"
+    channels = {"angle": ("rad", "rudder angle (+ trailing edge to starboard)")}
+
+    def __init__(self, name, spec, site_name, site, team, index: int):
+        self.index = index
+        super().__init__(name, spec, site_name, site, team)
+
+    def measurand(self, kin, cols):
+        return cols[f"rudder_{self.index}"]
+
+    def meta(self):
+        m = super().meta()
+        m["rudder_index"] = self.index
+        return m
+
+
+KINDS = {"gnss": GNSS, "range_radar": RangeRadar, "acoustic_range": AcousticRange, "loran": Loran,
+         "knotmeter": Knotmeter, "em_log": EMLog, "doppler_log": DopplerLog, "heading": Heading,
+         "attitude": Attitude, "imu": IMU, "anemometer": Anemometer, "shaft_torque": ShaftTorque,
+         "shaft_rpm": ShaftSpeed, "thrust": Thrustmeter, "pitch_indicator": PitchIndicator, "rudder": RudderAngle}

@@ -1,0 +1,108 @@
+"""What a sensor at a site on the hull would see, computed from the true state (numpy, vectorized).
+
+Rigid-body kinematics with the truth's body-frame quantities (origin O at midship waterline,
+axes x forward, y starboard, z down; world north-east-down):
+  position of site S:   p_S = p_O + R r_S
+  velocity of S:        v_S = ν₁ + ω × r_S                      (body axes; over ground or through water)
+  acceleration of S:    a_S = ν̇₁ + ω × ν₁ + ω̇ × r_S + ω × (ω × r_S)   (body axes, inertial)
+  specific force:       f_S = a_S − Rᵀ g,  g = (0, 0, g) in NED    (what an accelerometer reads)
+These are the same relations MuJoCo's site sensors use; computing them from the recorded truth lets
+instruments run on their own clocks after (or alongside) the simulation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import G
+
+
+def rotation_matrices(qw, qx, qy, qz) -> np.ndarray:
+    """(n, 3, 3) body→world rotation matrices from quaternion columns."""
+    n = np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    w, x, y, z = qw / n, qx / n, qy / n, qz / n
+    R = np.empty((len(w), 3, 3))
+    R[:, 0, 0] = 1 - 2 * (y * y + z * z)
+    R[:, 0, 1] = 2 * (x * y - w * z)
+    R[:, 0, 2] = 2 * (x * z + w * y)
+    R[:, 1, 0] = 2 * (x * y + w * z)
+    R[:, 1, 1] = 1 - 2 * (x * x + z * z)
+    R[:, 1, 2] = 2 * (y * z - w * x)
+    R[:, 2, 0] = 2 * (x * z - w * y)
+    R[:, 2, 1] = 2 * (y * z + w * x)
+    R[:, 2, 2] = 1 - 2 * (x * x + y * y)
+    return R
+
+
+def _stack(cols: dict, names) -> np.ndarray:
+    return np.column_stack([cols[n] for n in names])
+
+
+class SiteKinematics:
+    """Measurands at a hull site for a chunk of truth columns (dict of equal-length arrays)."""
+
+    def __init__(self, cols: dict, site: np.ndarray):
+        self.c = cols
+        self.r = np.asarray(site, dtype=float)
+        self.t = cols["t"]
+        self._R = None
+
+    @property
+    def R(self) -> np.ndarray:
+        if self._R is None:
+            self._R = rotation_matrices(self.c["qw"], self.c["qx"], self.c["qy"], self.c["qz"])
+        return self._R
+
+    @property
+    def omega(self) -> np.ndarray:
+        return _stack(self.c, ("p", "q", "r"))
+
+    def position(self) -> np.ndarray:
+        """(n, 3) north, east, down of the site [m]."""
+        return _stack(self.c, ("x", "y", "z")) + self.R @ self.r
+
+    def velocity_body(self, through_water: bool = False) -> np.ndarray:
+        """(n, 3) velocity of the site in body axes [m/s], over ground or through the water."""
+        v = _stack(self.c, ("u_r", "v_r", "w_r") if through_water else ("u", "v", "w"))
+        return v + np.cross(self.omega, self.r)
+
+    def velocity_world(self) -> np.ndarray:
+        """(n, 3) velocity of the site over ground, north-east-down [m/s]."""
+        return np.einsum("nij,nj->ni", self.R, self.velocity_body(False))
+
+    def specific_force(self) -> np.ndarray:
+        """(n, 3) specific force at the site in body axes [m/s²] (accelerometer truth)."""
+        om = self.omega
+        nu1 = _stack(self.c, ("u", "v", "w"))
+        a = (_stack(self.c, ("du", "dv", "dw")) + np.cross(om, nu1)
+             + np.cross(_stack(self.c, ("dp", "dq", "dr")), self.r) + np.cross(om, np.cross(om, self.r)))
+        g_body = G * self.R[:, 2, :]  # Rᵀ (0, 0, g): third row of R
+        return a - g_body
+
+    def apparent_wind(self, exponent: float = 1.0 / 7.0) -> tuple[np.ndarray, np.ndarray]:
+        """Apparent wind at the site: (speed [m/s], angle it comes from off the bow [rad], + starboard).
+
+        True wind from the truth record (speed at the wind-load reference height, direction it blows
+        from) scaled to the site's height above the waterline by the power-law profile, minus the
+        site's own velocity over ground (ship motion, including the lever arm of the mast: the
+        motion-induced velocity); horizontal components in the ship's level frame.
+        """
+        c = self.c
+        h = max(-self.position()[:, 2].mean(), 0.5)
+        Uref = c["wind_speed"]
+        zref = 10.0
+        U = Uref * (h / zref) ** exponent if np.any(Uref) else Uref
+        d = c["wind_direction"]
+        # wind velocity (towards) in world axes
+        wn = -U * np.cos(d)
+        we = -U * np.sin(d)
+        vs = self.velocity_world()
+        rel_n = wn - vs[:, 0]
+        rel_e = we - vs[:, 1]
+        psi = c["heading"]
+        # air velocity relative to the ship, in heading-aligned level axes
+        ax = rel_n * np.cos(psi) + rel_e * np.sin(psi)
+        ay = -rel_n * np.sin(psi) + rel_e * np.cos(psi)
+        speed = np.hypot(ax, ay)
+        angle = np.arctan2(-ay, -ax)  # the direction it comes FROM, off the bow
+        return speed, angle

@@ -1,0 +1,195 @@
+"""Instrument suites: which instruments a ship carries, where, with which catalogue spec; and the
+running set of instruments that turns truth into readings during and after a simulation.
+
+Suite file ``models/<ship>/instruments.toml``::
+
+    [[instrument]]
+    name = "gyro"              # unique
+    spec = "gyrocompass"       # an entry of vtrials/instruments/catalogue.toml
+    site = "gyro"              # an MJCF site of the hull (sensor position)
+    shaft = "port"             # shaft instruments: which shaft
+    rudder = "port"            # rudder synchro: which rudder
+    full_scale = 1.0e5         # instruments whose errors are % of full scale
+    [instrument.set]           # optional: override catalogue values (same keys and units)
+    noise = 0.05
+
+A scenario may list ``[[instrument]]`` tables too: one with a suite name overrides that entry,
+a new name adds an instrument. Every instrument draws from its own random stream, spawned from
+the scenario seed and keyed by its name (numpy SeedSequence), so streams are independent and do
+not depend on the order or number of instruments.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..schema import load_toml, num, read_table, text, unknown_key
+from .devices import KINDS, RudderAngle, ShaftDevice, SpecError
+
+CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
+SEED_KEY = 4  # spawn-key namespace of instrument streams
+
+
+@dataclasses.dataclass(frozen=True)
+class Entry:
+    name: str = text("instrument name (unique on the ship)")
+    spec: str = text("catalogue entry")
+    site: str = text("MJCF site of the sensor", default=None)
+    shaft: str = text("shaft measured (shaft instruments)", default=None)
+    rudder: str = text("rudder measured (rudder synchro)", default=None)
+    full_scale: float = num("full scale of the instrument (for % FS errors)", "", 0.0, 1e12, lo_open=True,
+                            default=None)
+
+
+def load_catalogue(path: Path = CATALOGUE) -> dict:
+    return load_toml(path)
+
+
+def _entries(items, f: str, section: str) -> list[tuple[Entry, dict, str]]:
+    if items is None:
+        return []
+    if not isinstance(items, list):
+        raise InputError(f, section, "expected [[instrument]] tables")
+    out = []
+    for i, tab in enumerate(items):
+        if not isinstance(tab, dict):
+            raise InputError(f, f"{section}[{i}]", "expected a table")
+        tab = dict(tab)
+        sets = tab.pop("set", {})
+        e, _ = read_table(Entry, tab, f, f"{section}[{i}]")
+        out.append((e, sets, f"{section}[{i}]"))
+    return out
+
+
+class InstrumentSet:
+    """The instruments of one ship, streaming truth chunks into readings."""
+
+    def __init__(self, vessel, seed: int, site_info: dict, scenario_items=None, scenario_file: str = "",
+                 stream: tuple = ()):
+        self.vessel = vessel
+        cat = load_catalogue()
+        suite_path = vessel.folder / "instruments.toml"
+        suite = _entries(load_toml(suite_path).get("instrument") if suite_path.is_file() else None,
+                         str(suite_path), "instrument")
+        extra = _entries(scenario_items, scenario_file, "instrument")
+        merged: dict[str, tuple[Entry, dict, str, str]] = {}
+        for e, sets, where in suite:
+            if e.name in merged:
+                raise InputError(str(suite_path), f"{where}.name", f"duplicate instrument {e.name!r}")
+            merged[e.name] = (e, sets, str(suite_path), where)
+        for e, sets, where in extra:
+            if e.name in merged:
+                base, bsets, _, _ = merged[e.name]
+                fields = {k: getattr(e, k) if getattr(e, k) is not None else getattr(base, k)
+                          for k in ("name", "spec", "site", "shaft", "rudder", "full_scale")}
+                merged[e.name] = (Entry(**fields), {**bsets, **sets}, scenario_file, where)
+            else:
+                merged[e.name] = (e, sets, scenario_file, where)
+        self.team = self._team(site_info)
+        self.devices = {}
+        for name in sorted(merged):
+            e, sets, f, where = merged[name]
+            self.devices[name] = self._build(e, sets, cat, f, where)
+        self.seed = seed
+        self.stream = tuple(stream)
+        self._out: dict[str, list] = {}
+
+    def _team(self, site_info: dict) -> dict:
+        v = self.vessel
+        p = v.particulars
+        team = {"site": site_info, "ship": v.name, "length_m": p.length, "beam_m": p.beam, "draught_m": p.draught,
+                "displacement_m3": p.displacement, "water_density": p.water_density,
+                "shafts": [s.name for s in v.shafts], "rudders": [r.name for r in v.rudders],
+                "propeller_diameters_m": [pr.diameter for pr in v.propellers],
+                "max_power_W": [s.max_power for s in v.shafts]}
+        if v.windage is not None:
+            from ..wind import wind_coefficients
+            ang = np.radians(np.arange(0.0, 181.0, 10.0))
+            cx, cy, cn, ck = wind_coefficients(ang, v.windage)
+            w = v.windage
+            team["windage"] = {"A_F_m2": w.A_F, "A_L_m2": w.A_L, "L_oa_m": w.L_oa,
+                               "angles_rad": ang.tolist(), "C_X": np.asarray(cx).tolist(),
+                               "C_Y": np.asarray(cy).tolist(), "C_N": np.asarray(cn).tolist()}
+        return team
+
+    def _build(self, e: Entry, sets: dict, cat: dict, f: str, where: str):
+        v = self.vessel
+        if e.spec not in cat:
+            raise unknown_key(f, f"{where}.spec", e.spec, list(cat))
+        spec = copy.deepcopy(cat[e.spec])
+        for k, val in sets.items():
+            if k not in spec and k not in KINDS.get(spec.get("kind"), KINDS["heading"]).extra_keys | \
+                    {"rate_hz", "bias", "scale", "gauss_markov", "random_walk", "noise", "resolution", "range",
+                     "latency_s", "hold_s", "update_s", "dropout_p", "clock_offset_s", "misalignment_deg"}:
+                raise InputError(f, f"{where}.set.{k}", f"not a parameter of spec {e.spec!r}")
+            spec[k] = val
+        kind = spec.get("kind")
+        if kind not in KINDS:
+            raise InputError(str(CATALOGUE), f"{e.spec}.kind", f"unknown kind {kind!r}")
+        cls = KINDS[kind]
+        site = np.zeros(3)
+        if e.site is not None:
+            if e.site not in v.sites:
+                raise InputError(f, f"{where}.site", f"unknown site {e.site!r} (sites of {v.name}: "
+                                                     f"{', '.join(sorted(v.sites))})")
+            site = v.sites[e.site]
+        try:
+            if issubclass(cls, ShaftDevice):
+                names = [s.name for s in v.shafts]
+                if e.shaft not in names:
+                    raise InputError(f, f"{where}.shaft", f"{e.shaft!r} is not a shaft of {v.name} ({', '.join(names)})")
+                k = names.index(e.shaft)
+                pk = [p.name for p in v.propellers].index(v.shafts[k].propeller)
+                pos = np.array([v.propellers[pk].x, v.propellers[pk].y, v.propellers[pk].z])
+                return cls(e.name, spec, e.site or f"shaft {e.shaft}", site if e.site else pos, self.team, pk,
+                           e.full_scale)
+            if cls is RudderAngle:
+                names = [r.name for r in v.rudders]
+                if e.rudder not in names:
+                    raise InputError(f, f"{where}.rudder", f"{e.rudder!r} is not a rudder of {v.name} "
+                                                           f"({', '.join(names)})")
+                k = names.index(e.rudder)
+                rd = v.rudders[k]
+                return cls(e.name, spec, f"rudder {e.rudder}", np.array([rd.x, rd.y, rd.z]), self.team, k)
+            if e.site is None:
+                raise InputError(f, f"{where}.site", f"a {kind} instrument needs a site")
+            return cls(e.name, spec, e.site, site, self.team)
+        except SpecError as exc:
+            raise InputError(f, f"{where}.{exc.field}", exc.problem) from None
+
+    # ------------------------------------------------------------------ running
+    def reset(self) -> None:
+        for name, dev in self.devices.items():
+            ss = np.random.SeedSequence(self.seed, spawn_key=(SEED_KEY, *self.stream, zlib.crc32(name.encode())))
+            dev.reset(np.random.Generator(np.random.PCG64(ss)))
+        self._out = {name: [] for name in self.devices}
+
+    def process(self, cols: dict) -> None:
+        """Feed one chunk of truth columns (times strictly after the previous chunk's)."""
+        if cols["t"].size == 0:
+            return
+        for name, dev in self.devices.items():
+            t, ch = dev.process(cols)
+            if t.size:
+                self._out[name].append((t, ch))
+
+    def readings(self, name: str) -> tuple[np.ndarray, dict]:
+        """All readings of one instrument so far: (time, {channel: values})."""
+        parts = self._out[name]
+        dev = self.devices[name]
+        if not parts:
+            return np.zeros(0), {c: np.zeros(0) for c in dev.channels}
+        t = np.concatenate([p[0] for p in parts])
+        return t, {c: np.concatenate([p[1][c] for p in parts]) for c in dev.channels}
+
+    def drawn(self) -> dict:
+        return {name: dev.drawn() for name, dev in self.devices.items()}
+
+    def meta(self) -> dict:
+        return {name: dev.meta() for name, dev in self.devices.items()}
