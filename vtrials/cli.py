@@ -49,7 +49,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="vtrials",
         description="vtrials — virtual ship trials: a MuJoCo ship in a modelled sea, run through trial "
                     "maneuvers, with the true motion recorded and every result scored against it.",
-        epilog="Commands:\n  run      simulate a scenario file and write truth, results and plots\n"
+        epilog="Commands:\n  run      simulate a scenario file and write truth, records, results and plots\n"
+               "  inspect  list a trial record's channels, rates and units; plot chosen channels\n"
                "  models   list the vessel models\n\nSee 'vtrials run --help' for the scenario format.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"vtrials {__version__}")
@@ -65,7 +66,64 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--no-plot", action="store_true", help="skip trajectory.png")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
     sub.add_parser("models", help="list the vessel models", description="List the vessel models under models/.")
+    ins = sub.add_parser("inspect", help="list a trial record's channels and plot some of them",
+                         description="List every instrument of a trial record (RECORD.nc) with its channels, "
+                                     "sample counts, mean rates and units, and its event marks; with --plot, draw "
+                                     "the chosen channels against time into a PNG.",
+                         formatter_class=argparse.RawDescriptionHelpFormatter,
+                         epilog="Channels are named INSTRUMENT/CHANNEL, e.g. gyro/heading knotmeter/speed.")
+    ins.add_argument("record", metavar="RECORD", help="trial record file (records/*.nc written by 'vtrials run')")
+    ins.add_argument("--plot", nargs="+", metavar="INSTRUMENT/CHANNEL", help="channels to plot")
+    ins.add_argument("--out", metavar="PNG", help="where to write the plot (default: RECORD with .png)")
     return p
+
+
+def _inspect(args) -> int:
+    from pathlib import Path
+
+    import numpy as np
+
+    from .records import RecordError, open_record
+    try:
+        rec = open_record(args.record)
+    except FileNotFoundError:
+        raise InputError(args.record, "", "file not found") from None
+    except (OSError, RecordError) as exc:
+        raise InputError(args.record, "", str(exc).split(": ", 1)[-1]) from None
+    print(f"{args.record}: {rec.attrs.get('title', '')}")
+    print(f"{'instrument/channel':<34} {'samples':>8} {'rate [Hz]':>10}  units")
+    for inst in rec.instruments:
+        for ch in rec.channels(inst):
+            t, x = rec.channel(inst, ch)
+            rate = (len(t) - 1) / (t[-1] - t[0]) if len(t) > 1 and t[-1] > t[0] else float("nan")
+            print(f"{inst + '/' + ch:<34} {len(t):>8} {rate:>10.3f}  {rec.units(inst, ch)}")
+    ev = rec.events
+    for tt, run, lab in zip(ev["time"], ev["run"], ev["label"]):
+        print(f"event  t = {tt:10.2f} s  run {run:3d}  {lab}")
+    if args.plot:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, axes = plt.subplots(len(args.plot), 1, figsize=(10, 2.4 * len(args.plot)), sharex=True, squeeze=False)
+        for ax, name in zip(axes[:, 0], args.plot):
+            inst, _, ch = name.partition("/")
+            if inst not in rec.instruments or ch not in rec.channels(inst):
+                raise InputError(args.record, name, "no such channel (see the list above)")
+            t, x = rec.channel(inst, ch)
+            ax.plot(t, x, lw=0.8)
+            ax.set_ylabel(f"{name}\n[{rec.units(inst, ch)}]", fontsize=8)
+            for tt in ev["time"]:
+                ax.axvline(tt, color="0.7", lw=0.6, ls="--")
+            ax.grid(True, alpha=0.3)
+        axes[-1, 0].set_xlabel("time [s] (dashed: event marks)")
+        fig.tight_layout()
+        out = Path(args.out) if args.out else Path(args.record).with_suffix(".png")
+        from .records import atomic_path
+        with atomic_path(out) as tmp:
+            fig.savefig(tmp, dpi=100, format="png")
+        plt.close(fig)
+        print(f"wrote {out}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -100,6 +158,8 @@ def main(argv: list[str] | None = None) -> int:
                     print(f"  {m['name']:<24} {m['kind']:<15} {summary}")
                 print(f"wrote {args.out}/results.json, truth.nc" + ("" if args.no_plot else ", trajectory.png"))
             return 0
+        if args.command == "inspect":
+            return _inspect(args)
     except SimulationError as exc:
         print(f"vtrials: simulation stopped: {exc}", file=sys.stderr)
         return 3

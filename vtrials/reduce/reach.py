@@ -252,6 +252,10 @@ class ReachResult:
         return out
 
 
+PSPLINE_RULE = 'cp'
+PSPLINE_GAMMA = 1.0
+
+
 class PSpline:
     """Penalised regression spline (Eilers & Marx 1996): cubic B-splines on equally spaced knots
     (spacing ``knot_dt`` [s]) and a third-order difference penalty λ‖D₃c‖² (λ → ∞ gives a quadratic in
@@ -284,7 +288,11 @@ class PSpline:
             c = Ainv @ Bty
             r = y - B @ c
             edf = float(np.sum(Ainv * BtB))  # trace(Ainv BtB), both symmetric
-            crit = float(r @ r) + 2 * sigma ** 2 * edf
+            rss = float(r @ r)
+            if PSPLINE_RULE == "cp":
+                crit = rss + 2 * PSPLINE_GAMMA * sigma ** 2 * edf
+            else:  # discrepancy: largest λ with RSS ≤ n σ²
+                crit = -lg if rss <= len(y) * sigma ** 2 else 1e300 + rss
             if best is None or crit < best[0]:
                 best = (crit, lam, Ainv, c, edf)
         _, self.lam, Ainv, self.c, self.edf = best
