@@ -11,7 +11,9 @@ def _numba_cache_dir() -> None:
     """Point numba's on-disk cache at a directory keyed by the hash of this package's sources.
 
     numba invalidates a cached kernel only when the kernel's own file changes, not when a kernel it
-    calls (in another module) does; keying the whole cache on all sources rules out stale kernels.
+    calls (in another module) does; keying the cache on every source that uses numba (a kernel can
+    only call kernels, which live in such files) rules out stale kernels, while edits elsewhere (the
+    reductions, the report) keep the cache.
     """
     import hashlib
     import os
@@ -22,8 +24,11 @@ def _numba_cache_dir() -> None:
     h = hashlib.sha256()
     pkg = Path(__file__).resolve().parent
     for f in sorted(pkg.rglob("*.py")):
+        src = f.read_bytes()
+        if b"numba" not in src and f.name not in ("units.py", "bseries.py"):  # constants kernels use
+            continue
         h.update(f.relative_to(pkg).as_posix().encode())
-        h.update(f.read_bytes())
+        h.update(src)
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "vtrials" / "numba"
     d = base / h.hexdigest()[:16]
     try:

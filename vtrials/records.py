@@ -161,6 +161,23 @@ class Record:
                 "label": [codes[str(c)] for c in code]}
 
 
+    @property
+    def run_log(self) -> list[dict]:
+        """The director's log sheet: one entry per executed run (course, settings, COMEX/EXECUTE/FINEX
+        times, steadiness verdicts, whether the run was accepted); empty for single maneuvers."""
+        return json.loads(self.attrs.get("run_log", "[]") or "[]")
+
+    def attr(self, name: str, default=None):
+        """A file attribute, JSON-decoded when it holds JSON."""
+        v = self.attrs.get(name, default)
+        if isinstance(v, str) and v[:1] in "{[":
+            try:
+                return json.loads(v)
+            except ValueError:
+                return v
+        return v
+
+
 def open_record(path: str | Path) -> Record:
     """Open a trial record for reading (numpy arrays out)."""
     return Record(path)

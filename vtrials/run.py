@@ -299,8 +299,14 @@ def write_outputs(result: RunResult, out_dir: str | Path, plot: bool = True) -> 
 
 def run(scenario_path: str | Path, out_dir: str | Path, nthread: int = 1, plot: bool = True,
         progress=None) -> RunResult:
-    """Load, check, simulate and write: the one code path behind ``vtrials run``."""
+    """Load, check, simulate and write: the one code path behind ``vtrials run``. A scenario with an
+    ``[agenda]`` goes through :mod:`vtrials.trialrun` (crew, records, reductions, scoring, report)."""
     scn = load_scenario(scenario_path)
+    if scn.agenda is not None:
+        from .trialrun import simulate_agenda, write_agenda_outputs
+        result = simulate_agenda(scn, progress=progress)
+        write_agenda_outputs(result, out_dir, plot=plot)
+        return result
     result = simulate(scn, nthread=nthread, progress=progress)
     write_outputs(result, out_dir, plot=plot)
     return result

@@ -7,7 +7,11 @@ every field):
 ``[initial]``       exactly one of froude_number / speed_kn / speed_mps; heading_deg; propulsion
 ``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.sea.Current`)
 ``[[maneuver]]``    one table per maneuver, with ``kind`` and that kind's fields
-                    (:mod:`vtrials.maneuvers`)
+                    (:mod:`vtrials.maneuvers`), run side by side, one ship each
+``[agenda]``        instead of maneuvers: a trial agenda executed run by run on one ship by the virtual
+                    crew (:mod:`vtrials.agenda`, :mod:`vtrials.crew`); ``[initial]`` is then optional
+                    (default: steady at the first run's setting, on its course)
+``[site]``, ``[[instrument]]``  the trial site as surveyed; additions/overrides of the ship's suite
 
 Everything is checked before anything runs or is written; every error names the file and the
 field.
@@ -35,7 +39,11 @@ class Head:
     seed: int = integer("seed of every random draw in the run (records are reproducible from it)", 0, 2 ** 63 - 1)
     timestep_s: float = num("simulation time step", "s", 0.0, 1.0, lo_open=True)
     planar: bool = flag("hold heave, roll and pitch at zero (3-DOF validation mode)", default=False)
-    record_every: int = integer("write the truth state every this many steps", 1, 100000, default=1)
+    record_every: int = integer("record the truth state every this many steps (the instruments sample "
+                                "this stream)", 1, 100000, default=1)
+    truth_every: int = integer("keep every this many recorded truth rows in truth.nc (agendas of hours may "
+                               "thin the file; instruments and scoring still see every row)", 1, 100000,
+                               default=1)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,6 +73,9 @@ class Site:
                                   "(right) of A→B, −1 port", "", -1.0, 1.0, default=-1.0)
     hydrophone_side: float = num("side of the hydrophone pair 1→2 the ship works on (±1)", "", -1.0, 1.0,
                                  default=-1.0)
+    range_center_north_m: float = num("centre of the measured course (runs are laid over it), north", "m",
+                                      default=0.0)
+    range_center_east_m: float = num("centre of the measured course, east", "m", default=0.0)
 
 
 DEFAULT_TRANSPONDERS = [[-10000.0, -6000.0], [-10000.0, 6000.0]]  # 10 km south of the range centre
@@ -92,6 +103,7 @@ class Scenario:
     vessel: Vessel
     site: dict = dataclasses.field(default_factory=dict)
     instrument_items: list = dataclasses.field(default_factory=list)
+    agenda: object = None  # vtrials.agenda.Agenda when the scenario is an agenda
 
     @property
     def speed(self) -> float:
@@ -110,7 +122,7 @@ class Scenario:
         return self.initial.heading_deg * DEG
 
 
-_TOP = ("scenario", "initial", "environment", "maneuver", "site", "instrument")
+_TOP = ("scenario", "initial", "environment", "maneuver", "agenda", "site", "instrument")
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -130,7 +142,10 @@ def load_scenario(path: str | Path) -> Scenario:
     vessel = load_vessel(ship, file_for_errors=f, field_for_errors="scenario.ship")
     init, _ = read_table(Initial, doc.get("initial", {}), f, "initial")
     given = [k for k in ("froude_number", "speed_kn", "speed_mps", "engine_order") if getattr(init, k) is not None]
-    if len(given) != 1:
+    has_agenda = "agenda" in doc
+    if has_agenda and "maneuver" in doc:
+        raise InputError(f, "agenda", "a scenario is either an agenda or a list of [[maneuver]] tables, not both")
+    if len(given) > 1 or (len(given) == 0 and not has_agenda):
         raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps, engine_order"
                          + (f" (got {', '.join(given)})" if given else ""))
     env_tab = dict(doc.get("environment", {}))
@@ -146,9 +161,9 @@ def load_scenario(path: str | Path) -> Scenario:
     wind, _ = read_table(Wind, wind_tab, f, "environment.wind")
     if wind.speed_kn > 0 and vessel.windage is None:
         raise InputError(f, "environment.wind.speed_kn", f"{vessel.name} has no [windage] data for wind loads")
-    items = doc.get("maneuver")
-    if not isinstance(items, list) or not items:
-        raise InputError(f, "maneuver", "expected at least one [[maneuver]] table")
+    items = doc.get("maneuver", [])
+    if not has_agenda and (not isinstance(items, list) or not items):
+        raise InputError(f, "maneuver", "expected at least one [[maneuver]] table (or an [agenda])")
     maneuvers = []
     names = set()
     max_rudder = math.degrees(vessel.max_rudder)
@@ -188,12 +203,17 @@ def load_scenario(path: str | Path) -> Scenario:
     site_obj, _ = read_table(Site, site_tab, f, "site")
     site = {"transponders": tr, "hydrophones": hy, "transponder_side": site_obj.transponder_side,
             "hydrophone_side": site_obj.hydrophone_side, "latitude_deg": site_obj.latitude_deg,
+            "range_center": [site_obj.range_center_north_m, site_obj.range_center_east_m],
             "water_depth_m": env.water_depth_m}
-    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []))
+    agenda = None
+    if has_agenda:
+        from .agenda import load_agenda
+        agenda = load_agenda(doc["agenda"], vessel, f)
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []), agenda)
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
     from .instruments.suite import InstrumentSet
     InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
-    if init.engine_order is None and scn.speed > 0.9 * _runaway_speed(vessel):
+    if given and init.engine_order is None and scn.speed > 0.9 * _runaway_speed(vessel):
         raise InputError(f, "initial", f"approach speed {scn.speed:.2f} m/s is beyond this hull model's range")
     return scn
 

@@ -33,15 +33,16 @@ def _json_attr(v):
 
 
 def record_groups(iset, t_end: float, events: list[tuple[float, int, int]],
-                  orders: list[tuple[float, str]]) -> dict:
+                  orders: list[tuple[float, str]], t_start: float = -np.inf, settings=None) -> dict:
     """Groups for :func:`vtrials.records.write_groups` from an instrument set's readings.
 
-    Samples stamped after ``t_end`` (the end of the recording) are dropped.
+    Only samples stamped in [t_start, t_end] (the span of the recording) are kept. ``settings``:
+    (t, shaft, rps order, pitch order, mode code) rows of the engine-room log, written as ``_settings``.
     """
     groups = {}
     for name, dev in iset.devices.items():
         t, ch = iset.readings(name)
-        keep = t <= t_end
+        keep = (t <= t_end) & (t >= t_start)
         variables = {c: (ch[c][keep], units, long) for c, (units, long) in dev.channels.items()}
         groups[name] = {"time": t[keep], "variables": variables,
                         "attrs": {k: _json_attr(v) for k, v in dev.meta().items()}}
@@ -55,12 +56,21 @@ def record_groups(iset, t_end: float, events: list[tuple[float, int, int]],
                             "variables": {"order": (np.array([ORDER_NUMBER[o[1]] for o in orders], float), "1",
                                                     "engine order code (see the codes attribute)")},
                             "attrs": {"codes": json.dumps({str(k): v for k, v in ORDER_CODES.items()})}}
+    if settings is not None:
+        st = np.array(settings, dtype=float).reshape(-1, 5)
+        groups["_settings"] = {"time": st[:, 0], "variables": {
+            "shaft": (st[:, 1], "1", "shaft index"),
+            "rps_order": (st[:, 2], "s-1", "ordered shaft speed"),
+            "pitch_order": (st[:, 3], "1", "ordered pitch ratio (CP)"),
+            "mode": (st[:, 4], "1", "shaft mode: 0 governed, 1 trailed, 2 locked")},
+            "attrs": {"content": "engine-room log of shaft orders"}}
     return groups
 
 
-def write_record(path: Path, iset, t_end: float, events, orders, title: str, extra_attrs: dict) -> None:
+def write_record(path: Path, iset, t_end: float, events, orders, title: str, extra_attrs: dict,
+                 t_start: float = -np.inf, settings=None) -> None:
     attrs = {"Conventions": "CF-1.10", "title": title, "content": "record", "vtrials_version": __version__,
              "team_knowledge": json.dumps(iset.team, sort_keys=True),
              "time_reference": "seconds of the data acquisition system's clock from the start of the trial"}
     attrs.update({k: _json_attr(v) for k, v in extra_attrs.items()})
-    write_groups(path, record_groups(iset, t_end, events, orders), attrs)
+    write_groups(path, record_groups(iset, t_end, events, orders, t_start, settings), attrs)

@@ -619,14 +619,38 @@ class ShaftDevice(Device):
 
 
 class ShaftTorque(ShaftDevice):
-    """Strain-gauge torsionmeter: the torque the shaft transmits to the propeller."""
+    """Strain-gauge torsionmeter: the torque the shaft transmits to the propeller.
+
+    Errors: gauge-factor / shear-modulus scale error, a zero offset (``bias_fs``), noise and
+    resolution. Before the trial the team sets the zero (shaft turned slowly ahead and astern on the
+    turning gear, readings averaged — ITTC 7.5-04-01-01.1): the zero reading it logs, in the record's
+    metadata, is the true offset plus the residual error of that procedure (``zero_set_fs``)."""
 
     kind = "shaft_torque"
-    extra_keys = {"bias_fs", "noise_fs", "resolution_fs"}
+    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs"}
     channels = {"torque": ("N m", "shaft torque")}
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        self.chain.reset(r2)
+        offset = 0.0
+        for part in self.chain.parts:
+            if isinstance(part, P.Bias):
+                offset = float(np.ravel(part.value)[0])
+        zs = float(self.spec.get("zero_set_fs", 0.0)) * (self.full_scale or 0.0)
+        self.zero_reading = offset + zs * float(r1.standard_normal())
 
     def measurand(self, kin, cols):
         return cols[f"prop_torque_{self.index}"]
+
+    def drawn(self):
+        return {"zero_reading_N_m": self.zero_reading, "chain": self.chain.drawn()}
+
+    def meta(self):
+        m = super().meta()
+        if hasattr(self, "zero_reading"):
+            m["zero_reading_N_m"] = self.zero_reading
+        return m
 
 
 class ShaftSpeed(ShaftDevice):

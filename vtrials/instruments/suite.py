@@ -169,24 +169,71 @@ class InstrumentSet:
             ss = np.random.SeedSequence(self.seed, spawn_key=(SEED_KEY, *self.stream, zlib.crc32(name.encode())))
             dev.reset(np.random.Generator(np.random.PCG64(ss)))
         self._out = {name: [] for name in self.devices}
+        self._pending: list[dict] = []
+        self._seen = {name: 0 for name in self.devices}  # pending chunks each device has processed
 
     def process(self, cols: dict) -> None:
         """Feed one chunk of truth columns (times strictly after the previous chunk's)."""
-        if cols["t"].size == 0:
-            return
-        for name, dev in self.devices.items():
-            t, ch = dev.process(cols)
+        self.push(cols)
+        self.flush()
+
+    def push(self, cols: dict) -> None:
+        """Queue a chunk of truth columns; instruments take it at the next :meth:`flush`. Streaming is
+        chunk-size invariant, so a display can flush the few instruments it shows often while the rest
+        take long chunks (each call has a fixed cost of ~0.4 ms per instrument)."""
+        if cols["t"].size:
+            self._pending.append(cols)
+
+    def flush(self, names=None) -> None:
+        """Bring the named instruments (default: all) up to the last pushed truth row."""
+        todo = self.devices if names is None else names
+        for name in todo:
+            k = self._seen[name]
+            if k >= len(self._pending):
+                continue
+            chunk = self._pending[k:]
+            cols = chunk[0] if len(chunk) == 1 else {c: np.concatenate([p[c] for p in chunk]) for c in chunk[0]}
+            t, ch = self.devices[name].process(cols)
             if t.size:
                 self._out[name].append((t, ch))
+            self._seen[name] = len(self._pending)
+        done = min(self._seen.values())
+        if done:
+            del self._pending[:done]
+            for name in self._seen:
+                self._seen[name] -= done
 
     def readings(self, name: str) -> tuple[np.ndarray, dict]:
         """All readings of one instrument so far: (time, {channel: values})."""
+        self.flush([name])
         parts = self._out[name]
         dev = self.devices[name]
         if not parts:
             return np.zeros(0), {c: np.zeros(0) for c in dev.channels}
         t = np.concatenate([p[0] for p in parts])
         return t, {c: np.concatenate([p[1][c] for p in parts]) for c in dev.channels}
+
+    def window(self, name: str, t0: float) -> tuple[np.ndarray, dict]:
+        """Readings of one instrument stamped at or after t0 (what a display shows over a recent window;
+        cost independent of the length of the recording). Flushes that instrument first."""
+        self.flush([name])
+        parts = self._out[name]
+        dev = self.devices[name]
+        k = len(parts)
+        while k > 0 and parts[k - 1][0].size and parts[k - 1][0][0] >= t0:
+            k -= 1
+        if k > 0:
+            k -= 1  # the part that straddles t0
+        sel = parts[k:]
+        if not sel:
+            return np.zeros(0), {c: np.zeros(0) for c in dev.channels}
+        t = np.concatenate([p[0] for p in sel])
+        keep = t >= t0
+        return t[keep], {c: np.concatenate([p[1][c] for p in sel])[keep] for c in dev.channels}
+
+    def of_kind(self, kind: str) -> list[str]:
+        """Names of the instruments of one kind (e.g. "shaft_torque"), in name order."""
+        return [n for n, d in self.devices.items() if d.kind == kind]
 
     def drawn(self) -> dict:
         return {name: dev.drawn() for name, dev in self.devices.items()}

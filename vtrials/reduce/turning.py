@@ -582,7 +582,7 @@ class TurningResult:
 
     turn_side: int
     approach_course: Estimate
-    approach_speed: Estimate
+    approach_speed: Estimate  # along ψ₀ through the water (approach ground velocity − drift) [m/s]
     steady: SteadyWindow
     drift: Drift | None
     advance: Estimate | None = None
@@ -698,7 +698,7 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     u = np.array([math.cos(psi0), math.sin(psi0)])
     nvec = np.array([-math.sin(psi0), math.cos(psi0)])
     v_app = np.array([bN, bE])
-    app_speed = Estimate(float(v_app @ u), math.sqrt((sbN * u[0]) ** 2 + (sbE * u[1]) ** 2))
+    var_app = (sbN * u[0]) ** 2 + (sbE * u[1]) ** 2
 
     # steady window and drift
     sw = steady or steady_window(th, psi, t_execute, tol=steady_tol, min_span_deg=min_span_deg,
@@ -726,6 +726,9 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     else:
         Nc, Ec = N, E
         Sd = np.zeros((2, 2))
+    # approach speed through the water: ground velocity of the approach minus the drift (current)
+    v_w = v_app - (drift_obj.vector if drift_obj is not None else 0.0)
+    app_speed = Estimate(float(v_w @ u), math.sqrt(var_app + float(u @ Sd @ u)))
 
     res = TurningResult(turn_side=side, approach_course=Estimate(float(psi0), psi0_se),
                         approach_speed=app_speed, steady=sw, drift=drift_obj,

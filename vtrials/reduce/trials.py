@@ -1,0 +1,478 @@
+"""Reducing a trial record: what the trials team does with the data of a standardization or a
+speed-log calibration trial, from the record file alone.
+
+Inputs (all from :class:`vtrials.records.Record`): the instrument groups (found by their ``kind``, not
+their names), the director's log sheet (``run_log``: run numbers, courses, settings, COMEX / EXECUTE /
+FINEX times, accepted runs), the team's knowledge (ship particulars, windage coefficients, surveyed
+sensor positions, nominal calibrations) and the tank prediction in the record's attributes.
+
+* :func:`run_statistics` — per run: mean, σ, standard error, min, max of every channel over the run
+  window [EXECUTE, FINEX] (seed 002 tabulates these for every run), SOG/COG from each tracking system
+  (straight-line fit) and from the LORAN display, shaft power per shaft (2π n Q from the torque and
+  r/min meters), net thrust (static load removed), relative wind.
+* :func:`reduce_standardization` — per spot: current elimination over its runs (two-run average,
+  1:2:1 mean of means, ITTC mean of means), with the run-to-run scatter the all-runs ITTC iterative
+  analysis leaves added to the tracking uncertainty; power corrected per run for the wind by the
+  direct power method (R_AA from the measured relative wind and the ship's coefficients, η_D from the
+  tank prediction); speed–power, r/min, torque and thrust against speed through water (cubic in
+  log–log, a power law whose exponent may vary with speed); the ITTC iterative method over all runs as
+  the alternative analysis.
+* :func:`reduce_log_calibration` — per leg ground speed; the current and the speeds through water from
+  a joint least-squares fit of every leg (|U_g h_i + c(t_i)|: one U per speed group, a current
+  vector, with a linear trend when the legs allow); the four-leg closed form (seed 000 App. A) and the
+  reciprocal-pair shortcut as the classic cross-checks; the knotmeter (and EM log) regression with
+  its statistics and 95 % band; the smoothing study of the 10-s counts.
+
+Everything is SI; results are plain dicts (JSON-ready) with Estimates as {value, std, dof, lo95, hi95}.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import optimize
+
+from vtrials.records import Record
+from vtrials.reduce import current as CUR
+from vtrials.reduce import logcal as LC
+from vtrials.reduce import runstats as RS
+from vtrials.reduce import speedpower as SP
+from vtrials.reduce.estimate import Estimate
+
+TRACKING_PREFERENCE = ("range_radar", "gnss", "acoustic_range")
+
+
+# ----------------------------------------------------------------------------------------- helpers
+def _est(e: Estimate | None) -> dict | None:
+    return None if e is None else e.to_dict()
+
+
+def _by_kind(rec: Record) -> dict:
+    out: dict = {}
+    for name in rec.instruments:
+        out.setdefault(rec.meta(name).get("kind"), []).append(name)
+    return out
+
+
+def _angular(kind: str, channel: str) -> bool:
+    return channel in ("heading", "cog") or (kind == "anemometer" and channel == "angle")
+
+
+def accepted_runs(rec: Record) -> list[dict]:
+    """The log sheet's accepted runs, in run order (one entry per run number)."""
+    return sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
+
+
+def run_statistics(rec: Record, run: dict) -> dict:
+    """Everything the team tabulates for one run window [EXECUTE, FINEX] (SI units)."""
+    t0, t1 = run["t_execute"], run["t_finex"]
+    kinds = _by_kind(rec)
+    channels = {}
+    for name in rec.instruments:
+        kind = rec.meta(name).get("kind")
+        st = {}
+        for ch in rec.channels(name):
+            t, x = rec.channel(name, ch)
+            try:
+                st[ch] = RS.channel_stats(t, x, t0, t1, angular=_angular(kind, ch)).to_dict()
+            except ValueError:  # fewer than two samples in the window (e.g. a slow display)
+                st[ch] = None
+        channels[name] = st
+    out = {"run": run["run"], "label": run["label"], "group": run["group"], "leg": run["leg"],
+           "course": math.radians(run["course_deg"]), "t_mid": 0.5 * (t0 + t1), "t_execute": t0,
+           "t_finex": t1, "steady": bool(run["approach_steady"] and run["run_steady"]),
+           "notes": run["approach_notes"] + run["run_notes"], "channels": channels, "sog": {}}
+    for kind in TRACKING_PREFERENCE:
+        for name in kinds.get(kind, []):
+            t, n = rec.channel(name, "north")
+            _, e = rec.channel(name, "east")
+            ok = np.isfinite(n) & np.isfinite(e)
+            try:
+                fit = RS.sog_from_track(t[ok], n[ok], e[ok], t0, t1)
+                out["sog"][name] = {"sog": _est(fit.sog), "cog": _est(fit.cog), "kind": kind,
+                                    "along_rms": fit.along_rms, "cross_rms": fit.cross_rms, "n": fit.n}
+            except ValueError:
+                pass
+    for name in kinds.get("loran", []):
+        t, v = rec.channel(name, "sog")
+        tu, vu = RS.updates_from_samples(t, v)
+        try:
+            out["sog"][name] = {"sog": _est(RS.sog_from_displayed(tu, vu, t0, t1)), "kind": "loran"}
+        except ValueError:
+            pass
+    primary = next((n for k in TRACKING_PREFERENCE for n in kinds.get(k, []) if n in out["sog"]), None)
+    if primary is None:
+        raise ValueError(f"run {run['run']}: no tracking fixes in the window")
+    out["tracking"] = primary
+    s = out["sog"][primary]["sog"]
+    out["vg"] = Estimate(s["value"], s["std"], s["dof"])
+    # shafts: power from the torque and r/min meters, net thrust, indicated pitch
+    shafts = {}
+    for name in kinds.get("shaft_torque", []):
+        m = rec.meta(name)
+        st = channels[name]["torque"]
+        if st is not None:  # the zero logged at the pre-trial zero setting is removed
+            z = float(m.get("zero_reading_N_m", 0.0))
+            st = {**st, "mean": st["mean"] - z, "min": st["min"] - z, "max": st["max"] - z}
+        shafts.setdefault(m["shaft_index"], {})["torque"] = st
+    for name in kinds.get("shaft_rpm", []):
+        k = rec.meta(name)["shaft_index"]
+        shafts.setdefault(k, {})["rps"] = channels[name]["rps"]
+    for name in kinds.get("thrust", []):
+        m = rec.meta(name)
+        st = channels[name]["thrust"]
+        if st is not None:
+            shafts.setdefault(m["shaft_index"], {})["thrust"] = {**st, "mean": st["mean"] - m["nominal_static_load_N"]}
+    for name in kinds.get("pitch_indicator", []):
+        shafts.setdefault(rec.meta(name)["shaft_index"], {})["pitch"] = channels[name]["pitch"]
+    power = []
+    for k in sorted(shafts):
+        sh = shafts[k]
+        if sh.get("torque") and sh.get("rps"):
+            q, n = sh["torque"], sh["rps"]
+            p = RS.shaft_power_estimate(Estimate(q["mean"], q["se"], max(q["n_eff"] - 1, 1)),
+                                        Estimate(n["mean"], n["se"], max(n["n_eff"] - 1, 1)))
+            sh["power"] = _est(p)
+            power.append(p)
+    out["shafts"] = {str(k): v for k, v in sorted(shafts.items())}
+    if power:
+        out["power"] = Estimate(sum(p.value for p in power), math.sqrt(sum(p.std ** 2 for p in power)))
+    # relative wind (the first anemometer in name order: the mast)
+    anem = kinds.get("anemometer", [])
+    if anem:
+        a = anem[0]
+        ts, sp = rec.channel(a, "speed")
+        _, an = rec.channel(a, "angle")
+        w = (ts >= t0) & (ts <= t1)
+        vx = float(np.mean(sp[w] * np.cos(an[w])))
+        vy = float(np.mean(sp[w] * np.sin(an[w])))
+        out["wind"] = {"instrument": a, "speed": math.hypot(vx, vy), "angle": math.atan2(vy, vx),
+                       "speed_se": channels[a]["speed"]["se"] if channels[a]["speed"] else math.nan,
+                       "height_m": -float(rec.meta(a)["surveyed_position_m"][2])}
+    return out
+
+
+def _mom(values, stds) -> Estimate:
+    """Current elimination over a spot's runs (alternating courses): 2 runs → simple average; 3 → 1:2:1
+    mean of means; 4 → ITTC (1, 3, 3, 1)/8; n → repeated averaging (binomial weights)."""
+    v = np.asarray(values, float)
+    n = v.size
+    if n == 2:
+        return CUR.two_run_average(v, stds)
+    if n == 3:
+        return CUR.three_run_mean_of_means(v, stds)
+    if n == 4:
+        return CUR.ittc_mean_of_means(v, stds)
+    return CUR.mean_of_means(v, stds)
+
+
+def _method_name(n: int) -> str:
+    return {2: "two-run average", 3: "mean of means 1:2:1", 4: "ITTC mean of means (1:3:3:1)/8"}.get(
+        n, f"mean of means over {n} runs")
+
+
+def _wind_cx(team: dict):
+    w = team.get("windage")
+    if not w:
+        return None
+    ang = np.asarray(w["angles_rad"])
+    cx_body = np.asarray(w["C_X"])
+
+    def cx(psi):
+        a = np.abs(np.arctan2(np.sin(psi), np.cos(psi)))
+        return -np.interp(a, ang, cx_body)  # resistance positive (body C_X is negative in head wind)
+    return cx, float(w["A_F_m2"])
+
+
+def _eta_d(tank: dict, v):
+    if not tank:
+        return None
+    return np.interp(v, tank["speed_mps"], tank["eta_D"])
+
+
+# ----------------------------------------------------------------------------------- standardization
+def reduce_standardization(rec: Record) -> dict:
+    team = rec.team
+    runs = [run_statistics(rec, r) for r in accepted_runs(rec)]
+    if not runs:
+        raise ValueError(f"{rec.path}: no accepted runs")
+    groups = sorted({r["group"] for r in runs})
+    tank = rec.attr("tank_prediction", {})
+    windinfo = _wind_cx(team)
+    rho_air = 1.225
+    # all-runs ITTC iterative analysis (tidal current model when the runs allow it): its residual
+    # scatter is the run-to-run variability the per-spot eliminations cannot see
+    tt = np.array([r["t_mid"] for r in runs])
+    vg = np.array([r["vg"].value for r in runs])
+    vg_se = np.array([r["vg"].std for r in runs])
+    hd = np.array([r["course"] for r in runs])
+    pw = np.array([r["power"].value for r in runs])
+    iterative = None
+    for model in ("tidal", "linear", "constant"):
+        try:
+            it = CUR.ittc_iterative(tt, vg, hd, pw, model=model)
+            if it.dof >= 2:
+                iterative = it
+                break
+        except (ValueError, np.linalg.LinAlgError, RuntimeError):
+            continue
+    sigma_run = 0.0
+    if iterative is not None:
+        # speed residual of each run about the fitted curve (power residual / slope of the curve)
+        vs = np.asarray(iterative.vs)
+        slope = iterative.b.value * iterative.q.value * vs ** (iterative.q.value - 1)
+        resid_v = (pw - iterative.power(vs)) / slope
+        sigma_run = float(math.sqrt(max(np.sum(resid_v ** 2) / iterative.dof - np.mean(vg_se ** 2), 0.0)))
+    spots = []
+    for g in groups:
+        rs = [r for r in runs if r["group"] == g]
+        n = len(rs)
+        v = [r["vg"].value for r in rs]
+        sv = [math.hypot(r["vg"].std, sigma_run) for r in rs]
+        vs = _mom(v, sv)
+        p_ms = np.array([r["power"].value for r in rs])
+        p_ms_se = np.array([r["power"].std for r in rs])
+        # wind: R_AA per run from the measured relative wind, then the direct power method
+        d_r = np.zeros(n)
+        d_r_se = np.zeros(n)
+        wind_used = []
+        if windinfo is not None and all("wind" in r for r in rs):
+            cx, a_xv = windinfo
+            wr = SP.wind_resistance([r["wind"]["speed"] for r in rs], [r["wind"]["angle"] for r in rs], v, cx,
+                                    a_xv, rho_air, z_anemometer=rs[0]["wind"]["height_m"], z_ref=10.0,
+                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=0.05)
+            d_r, d_r_se = wr.r_aa, wr.std
+            wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
+                         for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
+        eta = _eta_d(tank, vs.value)
+        if eta is not None:
+            p_id, p_id_se = SP.direct_power_method(p_ms, d_r, vs.value, float(eta), p_ms_std=p_ms_se,
+                                                   delta_r_std=d_r_se)
+        else:
+            p_id, p_id_se = p_ms, p_ms_se
+        # run-to-run power scatter at equal settings (gusts, helm) as seen after the correction
+        w = CUR.mean_of_means_weights(n)
+        P = _mom(p_id, np.hypot(p_id_se, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0))
+        P_ms = _mom(p_ms, p_ms_se)
+        rps = _mom([np.mean([float(s["rps"]["mean"]) for s in r["shafts"].values() if s.get("rps")]) for r in rs],
+                   [1e-3] * n)
+        torque = float(np.dot(w, [sum(s["torque"]["mean"] for s in r["shafts"].values() if s.get("torque"))
+                                  for r in rs]))
+        thrust = float(np.dot(w, [sum(s["thrust"]["mean"] for s in r["shafts"].values() if s.get("thrust"))
+                                  for r in rs])) if all(any(s.get("thrust") for s in r["shafts"].values())
+                                                       for r in rs) else None
+        s_i = np.cos(np.array([r["course"] for r in rs]) - rs[0]["course"])
+        current_along = [float(si * (vgi - vs.value)) for si, vgi in zip(s_i, v)]
+        spots.append({"group": g, "runs": [r["run"] for r in rs], "n_runs": n, "method": _method_name(n),
+                      "stw": _est(vs), "power_measured": _est(P_ms), "power": _est(P),
+                      "rps": rps.value, "torque": torque, "thrust": thrust,
+                      "current_along_base": current_along, "wind": wind_used,
+                      "eta_D": None if eta is None else float(eta),
+                      "steady": all(r["steady"] for r in rs)})
+    _two_run_trend_correction(spots, runs)
+    # the faired speed–power curve: monotone cubic through the spots in log–log (trial practice fairs
+    # the curve through the spots; a global law — the ITTC power law below — cannot follow a resistance
+    # hump to 1 %)
+    order = np.argsort([s["stw"]["value"] for s in spots])
+    V = np.array([spots[i]["stw"]["value"] for i in order])
+    Pp = np.array([spots[i]["power"]["value"] for i in order])
+    Ps = np.array([spots[i]["power"]["std"] for i in order])
+    curve = None
+    if len(spots) >= 2 and np.all(np.diff(V) > 0):
+        curve = {"kind": "pchip-loglog", "speed": V.tolist(), "power": Pp.tolist(), "rel_std": (Ps / Pp).tolist(),
+                 "speed_range": [float(V.min()), float(V.max())]}
+        for s in spots:
+            s["power_fit"] = {"value": float(curve_power(curve, s["stw"]["value"])),
+                              "rel_std": s["power"]["std"] / s["power"]["value"]}
+    runs_out = []
+    for r in runs:
+        d = {k: v for k, v in r.items() if k not in ("vg", "power")}
+        d["vg"] = _est(r["vg"])
+        d["power"] = _est(r.get("power"))
+        runs_out.append(d)
+    out = {"kind": "standardization", "tracking": runs[0]["tracking"], "runs": runs_out, "spots": spots,
+           "curve": curve, "sigma_run_mps": sigma_run}
+    if iterative is not None:
+        out["ittc_iterative"] = {"model": iterative.model, "vs": list(map(float, iterative.vs)),
+                                 "vs_std": list(map(float, iterative.vs_std)),
+                                 "current": list(map(float, iterative.current)),
+                                 "a": _est(iterative.a), "b": _est(iterative.b), "q": _est(iterative.q),
+                                 "dof": iterative.dof, "runs": [r["run"] for r in runs]}
+    return out
+
+
+def curve_power(curve: dict, v) -> np.ndarray:
+    """Power [W] of a reduced faired curve (:func:`reduce_standardization`) at speeds v [m/s]; NaN
+    outside the measured range."""
+    from scipy.interpolate import PchipInterpolator
+    f = PchipInterpolator(np.log(curve["speed"]), np.log(curve["power"]), extrapolate=False)
+    return np.exp(f(np.log(np.asarray(v, float))))
+
+
+def _two_run_trend_correction(spots: list[dict], runs: list[dict]) -> None:
+    """A two-run average assumes a constant current; a current changing at ċ leaves an error
+    −s₁ ċ Δt/2 (s₁ = ±1 the first run's sense along the base course, Δt between the runs). When the
+    trial has other spots, ċ is the slope of the along-course current they imply against time (a
+    straight line through the spots' implied currents), and two-run spots are corrected by it, with
+    its uncertainty added (seed 002 allows two-run spots only in weak, steady currents)."""
+    if len(spots) < 2 or not any(s["n_runs"] == 2 for s in spots):
+        return
+    byrun = {r["run"]: r for r in runs}
+    c0 = runs[0]["course"]
+    tt, cc = [], []
+    for s in spots:
+        rs = [byrun[k] for k in s["runs"]]
+        for r, c in zip(rs, s["current_along_base"]):
+            sgn = math.cos(rs[0]["course"] - c0)  # express along the trial's first course
+            tt.append(r["t_mid"])
+            cc.append(c * sgn)
+    tt, cc = np.array(tt), np.array(cc)
+    if np.ptp(tt) <= 0 or tt.size < 4:
+        return
+    A = np.column_stack([np.ones_like(tt), tt - tt.mean()])
+    coef, res, *_ = np.linalg.lstsq(A, cc, rcond=None)
+    dof = tt.size - 2
+    s2 = float(np.sum((cc - A @ coef) ** 2)) / dof if dof > 0 else 0.0
+    rate, rate_se = float(coef[1]), math.sqrt(s2 / float(np.sum((tt - tt.mean()) ** 2)))
+    for s in spots:
+        if s["n_runs"] != 2:
+            continue
+        r1, r2 = byrun[s["runs"][0]], byrun[s["runs"][1]]
+        s1 = math.cos(r1["course"] - c0)
+        dt = r2["t_mid"] - r1["t_mid"]
+        corr = s1 * rate * dt / 2.0
+        st = s["stw"]
+        s["stw"] = Estimate(st["value"] + corr, math.hypot(st["std"], rate_se * dt / 2.0)).to_dict()
+        s["method"] = "two-run average, corrected for the current trend of the trial's spots"
+        s["trend_correction"] = corr
+
+
+# ----------------------------------------------------------------------------------- log calibration
+def _joint_current_fit(t, heading, vg, group, trend: bool):
+    """|U_g h_i + c(t_i)| least squares: parameters U per group, c_N, c_E (and their rates)."""
+    groups = sorted(set(group))
+    gi = np.array([groups.index(g) for g in group])
+    G = len(groups)
+    tm = float(np.mean(t))
+    hc, hs = np.cos(heading), np.sin(heading)
+
+    def model(x):
+        U = x[:G][gi]
+        cn = x[G] + (x[G + 2] * (t - tm) if trend else 0.0)
+        ce = x[G + 1] + (x[G + 3] * (t - tm) if trend else 0.0)
+        return np.hypot(U * hc + cn, U * hs + ce)
+
+    x0 = np.concatenate([[np.mean(vg[gi == k]) for k in range(G)], [0.0, 0.0], [0.0, 0.0] if trend else []])
+    res = optimize.least_squares(lambda x: model(x) - vg, x0, method="lm", xtol=1e-14, ftol=1e-14)
+    J = res.jac
+    n, p = vg.size, x0.size
+    dof = n - p
+    s2 = float(res.fun @ res.fun) / dof if dof > 0 else math.nan
+    cov = np.linalg.pinv(J.T @ J) * s2
+    return groups, res.x, cov, dof, tm, res.fun
+
+
+def reduce_log_calibration(rec: Record) -> dict:
+    runs = [run_statistics(rec, r) for r in accepted_runs(rec)]
+    kinds = _by_kind(rec)
+    t = np.array([r["t_mid"] for r in runs])
+    hd = np.array([r["course"] for r in runs])
+    vg = np.array([r["vg"].value for r in runs])
+    grp = [r["group"] for r in runs]
+    G = len(set(grp))
+    trend = len(runs) - (G + 4) >= 3
+    groups, x, cov, dof, tm, resid = _joint_current_fit(t, hd, vg, grp, trend)
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    U = {g: Estimate(float(x[k]), float(sd[k]), dof) for k, g in enumerate(groups)}
+    cur = {"north": Estimate(float(x[G]), float(sd[G]), dof), "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof),
+           "trend": trend, "t_ref": tm}
+    if trend:
+        cur["north_rate"] = Estimate(float(x[G + 2]), float(sd[G + 2]), dof)
+        cur["east_rate"] = Estimate(float(x[G + 3]), float(sd[G + 3]), dof)
+    # classic cross-checks per group: the four-leg closed form and the reciprocal-pair shortcut
+    classic = {}
+    for g in groups:
+        rs = [r for r in runs if r["group"] == g]
+        if len(rs) == 4:
+            try:
+                fl = CUR.four_leg_current(*[r["vg"].value for r in rs], heading0=rs[0]["course"],
+                                          std=[r["vg"].std for r in rs])
+                classic[g] = {"method": "four-leg (seed 000 App. A)", "u": _est(fl.u), "c": _est(fl.c),
+                              "theta": _est(fl.theta)}
+            except ValueError as exc:
+                classic[g] = {"method": "four-leg", "error": str(exc)}
+        elif len(rs) == 2:
+            pr = CUR.reciprocal_pair_speed(rs[0]["vg"].value, rs[1]["vg"].value,
+                                           std=[rs[0]["vg"].std, rs[1]["vg"].std])
+            classic[g] = {"method": "reciprocal pair √((Vx² + Vy²)/2) (uncorrected)", "u": _est(pr),
+                          "two_run_average": 0.5 * (rs[0]["vg"].value + rs[1]["vg"].value)}
+    # the log readings per leg, and the calibration regressions
+    knot = kinds.get("knotmeter", [])
+    em = kinds.get("em_log", [])
+    legs = []
+    for r in runs:
+        leg = {"run": r["run"], "group": r["group"], "course": r["course"], "t_mid": r["t_mid"],
+               "vg": _est(r["vg"]), "stw": _est(U[r["group"]]), "tracking": r["tracking"],
+               "loran_sog": next((_s["sog"] for _s in r["sog"].values() if _s.get("kind") == "loran"), None)}
+        for name in knot:
+            st = r["channels"][name]["speed"]
+            leg[f"{name}_speed"] = None if st is None else st["mean"]
+        for name in em:
+            st = r["channels"][name]["speed"]
+            leg[f"{name}_speed"] = None if st is None else st["mean"]
+        legs.append(leg)
+    calibrations = {}
+    for name in knot + em:
+        pts = {}
+        for leg in legs:
+            xv = leg.get(f"{name}_speed")
+            if xv is None or xv <= 0.0:  # below break-away (or astern): the log shows nothing
+                continue
+            pts.setdefault(leg["group"], []).append(xv)
+        gs = sorted(pts)
+        if len(gs) < 3:
+            calibrations[name] = {"error": f"only {len(gs)} speeds with readings: no regression"}
+            continue
+        xr = np.array([np.mean(pts[g]) for g in gs])
+        yr = np.array([U[g].value for g in gs])
+        ys = np.array([U[g].std for g in gs])
+        cal = LC.calibrate(xr, yr, std=ys, absolute_sigma=False)
+        xs = np.linspace(0.0, float(xr.max()) * 1.05, 50)
+        lo, hi = cal.band(xs) if hasattr(cal, "band") else (None, None)
+        calibrations[name] = {"intercept": _est(cal.beta0), "slope": _est(cal.beta1), "r2": cal.r2, "see": cal.see,
+                              "n": cal.n, "dof": cal.dof, "x": xr.tolist(), "y": yr.tolist(), "y_std": ys.tolist(),
+                              "groups": gs, "excluded_groups": sorted(set(groups) - set(gs)),
+                              "band_x": xs.tolist(),
+                              "band_lo": None if lo is None else np.asarray(lo).tolist(),
+                              "band_hi": None if hi is None else np.asarray(hi).tolist()}
+    # smoothing study on the knotmeter counts of every leg (seed 000 Figs. 4–5)
+    smoothing = {}
+    for name in knot:
+        tc, cnt = rec.channel(name, "counts")
+        window = float(rec.meta(name).get("count_window_s", 10.0))
+        per_leg = []
+        for r in runs:
+            w = (tc >= r["t_execute"]) & (tc <= r["t_finex"])
+            if np.count_nonzero(w) >= 6 and np.any(cnt[w] > 0):
+                sm = LC.smoothing_study(tc[w], cnt[w], [1, 2, 3, 4, 6])
+                per_leg.append({"run": r["run"], "k": sm.k.tolist(),
+                                "std_kn": (np.asarray(sm.std) / window).tolist()})
+        smoothing[name] = per_leg
+    return {"kind": "log_calibration", "tracking": runs[0]["tracking"], "legs": legs,
+            "groups": {str(g): _est(U[g]) for g in groups},
+            "current": {k: (_est(v) if isinstance(v, Estimate) else v) for k, v in cur.items()},
+            "fit": {"dof": dof, "residual_rms": float(np.sqrt(np.mean(resid ** 2))), "trend": trend},
+            "classic": {str(g): v for g, v in classic.items()}, "calibrations": calibrations,
+            "smoothing": smoothing,
+            "runs": [{k: v for k, v in r.items() if k not in ("vg", "power")} | {"vg": _est(r["vg"])} for r in runs]}
+
+
+def reduce_record(rec: Record) -> dict:
+    """Reduce a trial record by its kind."""
+    kind = rec.attrs.get("kind")
+    if kind == "standardization":
+        return reduce_standardization(rec)
+    if kind == "log_calibration":
+        return reduce_log_calibration(rec)
+    raise ValueError(f"{rec.path}: no reduction for trial kind {kind!r}")
