@@ -37,7 +37,7 @@ class Steadiness:
     the last ``window_s``: the linear trend across the window and the scatter about it."""
 
     window_s: float = num("length of the look-back window", "s", 10.0, 1800.0, default=60.0)
-    rpm_pct: float = num("allowed change of shaft speed across the window (trend) and its 2σ scatter",
+    rpm_pct: float = num("allowed change of shaft speed across the window (trend)",
                          "%", 0.0, 50.0, lo_open=True, default=0.5)
     torque_pct: float = num("allowed change of shaft torque across the window (trend)", "%", 0.0, 50.0,
                             lo_open=True, default=2.0)

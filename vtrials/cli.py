@@ -33,6 +33,16 @@ def _scenario_help() -> str:
     for kind, cls in KINDS.items():
         parts.append(f"    kind = \"{kind}\": {textwrap.shorten(cls.__doc__ or '', 150)}")
         parts.append(_fields(cls, indent="      "))
+    from .agenda import AgendaRules, SpeedSpec, SpotSpec, Steadiness, TrialHead
+    parts += [
+        "", "  [agenda]   instead of maneuvers: a trial agenda run by the virtual crew on one ship", _fields(AgendaRules),
+        "  [agenda.steadiness]   how the director judges a steady approach", _fields(Steadiness),
+        "  [[agenda.trial]]   one table per trial", _fields(TrialHead),
+        "  [[agenda.trial.spot]]   (kind = \"standardization\") one power setting", _fields(SpotSpec),
+        "  [[agenda.trial.speed]]   (kind = \"log_calibration\") one speed", _fields(SpeedSpec),
+        "  An agenda writes records/<trial>.nc, truth.nc, results.json (a 'trials' list with reduced,",
+        "  truth and error per trial) and report.md with PNG figures.",
+    ]
     parts += [
         "",
         "Outputs in DIR: truth.nc (true state history, one netCDF group per maneuver), results.json",
@@ -126,6 +136,24 @@ def _inspect(args) -> int:
     return 0
 
 
+def _run_agenda(scn, args) -> int:
+    """An agenda: the crew's progress per run, then the scores of every trial."""
+    from .trialrun import simulate_agenda, write_agenda_outputs
+    say = None if args.quiet else (lambda line: print(line, flush=True))
+    if say:
+        say(f"vtrials: {scn.head.title} — agenda of {len(scn.agenda.runs)} runs, ship {scn.vessel.name}")
+    result = simulate_agenda(scn, progress=say)
+    doc = write_agenda_outputs(result, args.out, plot=not args.no_plot)
+    if say:
+        say(f"trial time {doc['agenda']['total_time_s'] / 3600:.2f} h simulated in {doc['wall_time_s']:.1f} s wall time")
+        for tr in doc["trials"]:
+            sm = tr["error"]["summary"]
+            say(f"  {tr['name']:<20} {tr['kind']:<16} " + ", ".join(
+                f"{k} {v:.4g}" for k, v in sm.items() if isinstance(v, (int, float))))
+        say(f"wrote {args.out}/results.json, truth.nc, records/*.nc" + ("" if args.no_plot else ", report.md"))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -144,6 +172,8 @@ def main(argv: list[str] | None = None) -> int:
             if args.threads < 1:
                 raise InputError("--threads", "", "must be at least 1")
             scn = load_scenario(args.scenario)
+            if scn.agenda is not None:
+                return _run_agenda(scn, args)
             if not args.quiet:
                 print(f"vtrials: {scn.head.title} — {len(scn.maneuvers)} maneuver(s), ship {scn.vessel.name}",
                       flush=True)

@@ -73,7 +73,7 @@ def _initial_state(sim: Simulator, scn: Scenario) -> ShipState:
     rules = scn.agenda.rules
     if rules.measured_course and abs(s.heading - heading) < 1e-9:
         # start on the first run's line, far enough before the range centre to settle and approach
-        back = abs(s.u) * (rules.runout_s + rules.approach_s + 0.5 * first.duration)
+        back = abs(s.u) * (2.0 * rules.runout_s + rules.approach_s + 0.5 * first.duration)
         c = scn.site.get("range_center", [0.0, 0.0])
         s = dataclasses.replace(s, x=c[0] - back * math.cos(heading), y=c[1] - back * math.sin(heading))
     sim.set_state(0, s)
@@ -124,6 +124,12 @@ def calm_water_truth(scn: Scenario, crew: Crew) -> dict:
                              "pitch": a.pitch_ordered if a.pitch_ordered[0] is not None else None,
                              "modes": list(a.modes)})
         extra = []
+        # the two ends, a little beyond the measured range (the reduced speeds scatter about the spots)
+        for st, f in ((settings[0], 0.96), (settings[-1], 1.03)):
+            gov = [k for k, m in enumerate(st["modes"]) if m == "governed"]
+            rps = [r * f if k in gov else r for k, r in enumerate(st["rps"])]
+            if all(r <= sh.max_rps for r, sh in zip(rps, scn.vessel.shafts)):
+                extra.append({**st, "group": None, "rps": rps})
         for s0, s1 in zip(settings, settings[1:]):
             if s0["modes"] == s1["modes"]:
                 mid = {"group": None, "modes": s0["modes"],

@@ -20,23 +20,25 @@ Method (:func:`reach_analysis`):
    fit of the approach minute (a spline would round the corner in the track at EXECUTE).
 2. s(t) and y(t) are each fitted with a penalised smoothing spline (:class:`PSpline`: cubic
    B-splines on knots every ~4 samples, third-order difference penalty — the λ → ∞ limit is constant
-   acceleration) whose penalty λ minimises RSS + 2γσ²·edf (Mallows' C_p inflated by γ = 10 because the
-   speed, a derivative, wants more smoothing than the positions), σ being the position noise
-   estimated independently from the residuals of piecewise cubic fits: the smoothing is set by the
-   measured noise, not by eye. Why a smoothing spline: a polynomial over a whole run (the seed-002
-   practice) cannot follow both the approach and a crash stop; a monotone fit would forbid what a
-   crash stop does (the reach stops growing and the ship gathers sternway), and the zero crossing of
-   the speed is the quantity wanted. Why fixed knots and a penalty rather than FITPACK's
+   acceleration). λ minimises RSS + 2γσ²·edf, σ being the position noise estimated independently
+   from the residuals of piecewise cubic fits, so the smoothing is set by the measured noise, not by
+   eye. Two fits per coordinate: γ = 1 (Mallows' C_p, MSE-optimal for positions) gives the reach,
+   lateral offset and path length; γ = 10 (more smoothing, since the MSE of a derivative is
+   minimised by a larger λ) gives the speeds and the instants found from them (DIW, band entry,
+   90 %). Why a smoothing spline: a polynomial over a whole run (the seed-002 practice) cannot
+   follow both the approach and a crash stop; a monotone fit would forbid what a crash stop does
+   (the reach stops growing and the ship gathers sternway), and the zero crossing of the speed is
+   the quantity wanted. Why fixed knots and a penalty rather than FITPACK's
    ``UnivariateSpline(s=n)`` or ``make_smoothing_spline``: FITPACK chooses its knots from the data,
    so resampled replicates get different knots and the bootstrap spread is dominated by that
    discrete choice (it overstated the scatter of the time to DIW ~5× in trials here), and
-   ``make_smoothing_spline`` is ~1000× slower; the P-spline is a fixed linear smoother, so every
-   bootstrap replicate is one matrix product.
+   ``make_smoothing_spline`` is ~1000× slower; the P-spline is a linear smoother in the
+   Demmler–Reinsch basis, so λ is re-selected for every bootstrap replicate at negligible cost.
 3. Speed: u(t) = ds/dt along the approach course, or, when a gyro is given, the surge over the
    corrected ground, u = s′ cos Δψ + y′ sin Δψ (Δψ = ψ − ψ₀; matters when the rudder is used).
    Track speed U = sign(u)·√(s′² + y′²).
    * Dead in the water (DIW): the first instant after EXECUTE at which u changes sign from the
-     approach sign. Reported: time to DIW, head reach s(t_DIW), lateral deviation y(t_DIW), track reach
+     approach sign (looked for only when the approach speed differs from 0 by > 3 SE and 0.05 m/s). Reported: time to DIW, head reach s(t_DIW), lateral deviation y(t_DIW), track reach
      ∫|V| dt of the fitted track from EXECUTE to t_DIW (the path length of the raw fixes would be
      inflated by their noise; computed as the head reach plus ∫(|V| − ṡ) dt).
    * Terminal speed U_T: straight-line fit of s and y over the tail of the record (the last
@@ -44,13 +46,14 @@ Method (:func:`reach_analysis`):
      quadratic over the tail shows a speed change larger than the band across the tail with z > 3.
      Band: |U − U_T| ≤ ``band_fraction``·|U_T − U_0| (2 %; floor 0.01 m/s), the same definition as the
      truth metrics of this project; time to terminal speed = the instant the fitted U enters the band
-     for good (searched up to the start of the tail window, where the speed is U_T by definition); the reach and track distance at that instant are reported with it. Also the time to 90 %
-     of the speed change (better conditioned than the band entry of an exponential approach).
-4. Uncertainty: residual bootstrap (default 200 replicates): the residuals of both fits (inflated by
-   √(n/(n − edf)) for the shrinkage of fitted residuals) are resampled —
-   i.i.d., or in moving blocks of ``block`` samples for time-correlated tracking error — added to the
-   fitted curves, and the whole reduction (spline fits with the same λ, crossings, tail fits, band
-   entry) is repeated. The bootstrap is used rather than linear propagation because the
+     for good (searched up to the start of the tail window, where the speed is U_T by definition);
+     the reach and track distance at that instant are reported with it. Also the time to 90 % of
+     the speed change (better conditioned than the band entry of an exponential approach).
+4. Uncertainty: residual bootstrap (default 200 replicates): the residuals of the C_p fits
+   (inflated by √(n/(n − edf)) for the shrinkage of fitted residuals) are resampled — i.i.d., or in
+   moving blocks of ``block`` samples for time-correlated tracking error — added to the C_p fits, and
+   the whole reduction (both fits with λ re-selected, EXECUTE position, crossings, tail fits, band
+   entry) is repeated; the spread of the replicates is the standard uncertainty. The bootstrap is used rather than linear propagation because the
    crossing instant, the band entry and the path length are non-linear functionals of the fit. Added
    in quadrature: the approach-course error (δs = y δψ₀, δy = −s δψ₀) and the drift error
    ((t − t_e)·δD projected, and δu/|u̇| for the crossing time). Not covered: smoothing bias (kept
@@ -64,6 +67,7 @@ import math
 from typing import Sequence
 
 import numpy as np
+from scipy import sparse
 from scipy.interpolate import BSpline
 
 from vtrials.reduce.estimate import Estimate
@@ -278,11 +282,12 @@ class PSpline:
         nint = max(4, int(math.ceil((t1 - t0) / knot_dt)))
         inner = np.linspace(t0, t1, nint + 1)
         self.knots = np.concatenate([[t0] * degree, inner, [t1] * degree])
-        self.B = BSpline.design_matrix(t, self.knots, degree).toarray()
+        # sparse (4 non-zeros per row): the products stay cheap and single-threaded
+        self.B = sparse.csr_matrix(BSpline.design_matrix(t, self.knots, degree))
         m = self.B.shape[1]
         Dm = np.diff(np.eye(m), penalty_order, axis=0)
         P = Dm.T @ Dm
-        BtB = self.B.T @ self.B
+        BtB = (self.B.T @ self.B).toarray()
         BtB = BtB + 1e-10 * np.trace(BtB) / m * np.eye(m)  # basis functions inside long gaps
         Li = np.linalg.inv(np.linalg.cholesky(BtB))
         kappa, U = np.linalg.eigh(Li @ P @ Li.T)
@@ -311,12 +316,12 @@ class PSpline:
         return (C[:, 0], float(edf[0])) if one else (C, edf)
 
     def design(self, tg):
-        """Basis values and first derivatives at tg: (G0, G1), each (len(tg), m)."""
+        """Basis values and first derivatives at tg: sparse (G0, G1), each (len(tg), m)."""
         sp = BSpline(self.knots, np.eye(self.B.shape[1]), self.k, extrapolate=False)
-        return sp(tg), sp.derivative()(tg)
+        return sparse.csr_matrix(np.nan_to_num(sp(tg))), sparse.csr_matrix(np.nan_to_num(sp.derivative()(tg)))
 
 
-def _metrics(tg, s, y, vs, vy, dpsi_g, U0, tail_t, s_tail, y_tail, band_fraction):
+def _metrics(tg, s, y, vs, vy, dpsi_g, U0, tail_t, s_tail, y_tail, band_fraction, check_diw=True):
     """All run metrics on the dense grid ``tg`` (t ≥ t_execute): positions s, y (relative to
     EXECUTE) from the position fit; speeds vs, vy from the speed fit."""
     u = vs if dpsi_g is None else vs * np.cos(dpsi_g) + vy * np.sin(dpsi_g)
@@ -333,7 +338,7 @@ def _metrics(tg, s, y, vs, vy, dpsi_g, U0, tail_t, s_tail, y_tail, band_fraction
     # dead in the water: sign change of u away from the approach sign
     f = sgn0 * u
     idx = np.flatnonzero((f[:-1] > 0) & (f[1:] <= 0))
-    if idx.size and abs(U0) > 0:
+    if idx.size and check_diw:
         k = int(idx[0])
         a = f[k] / (f[k] - f[k + 1])
         td = tg[k] + a * (tg[k + 1] - tg[k])
@@ -403,12 +408,10 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
     tp, N, E = _clean(t, north, east)
     if drift is not None:
         (dn, sdn), (de, sde) = _drift_components(drift)
-        D = np.array([dn, de])
         SD = np.diag([sdn ** 2, sde ** 2])
         N = N - dn * (tp - t_execute)
         E = E - de * (tp - t_execute)
     else:
-        D = np.zeros(2)
         SD = np.zeros((2, 2))
         notes.append("no drift correction")
     ma = (tp >= t_execute - approach_s) & (tp <= t_execute)
@@ -455,7 +458,7 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
     # two fits per coordinate: positions with C_p smoothing (γ = 1, position-optimal), speeds and
     # the instants found from them (DIW, band entry, 90 %) with the heavier speed smoothing γ
     basis = PSpline(tf, kdt)
-    gdt = grid_dt or min(0.1, 0.2 * dt_med)
+    gdt = grid_dt or min(0.25, 0.25 * dt_med)
     tg = np.arange(t_execute, t_end + 1e-9, gdt)
     dpsi_g = None
     if hd is not None:
@@ -465,6 +468,8 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
     tail = tf >= t_end - tail_len
     if np.count_nonzero(tail) < 5:
         raise ValueError("too few fixes in the tail window")
+    # dead in the water is looked for only when the approach was under way (|U₀| > 3 SE, 0.05 m/s)
+    moving = abs(U0) > max(3 * U0_se, 0.05)
     G0, G1 = basis.design(tg)
     # linear functional giving the approach-line value at EXECUTE from the data vector
     m_app = (tf <= t_execute)
@@ -483,7 +488,7 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         sg, yg = G0 @ cs - s_e, G0 @ cy - y_e
         vsg, vyg = G1 @ vs_c, G1 @ vy_c
         return [_metrics(tg, sg[:, j], yg[:, j], vsg[:, j], vyg[:, j], dpsi_g, U0,
-                         tf[tail], S_d[tail, j] - s_e[j], Y_d[tail, j] - y_e[j], band_fraction)
+                         tf[tail], S_d[tail, j] - s_e[j], Y_d[tail, j] - y_e[j], band_fraction, moving)
                 for j in range(S_d.shape[1])]
 
     base = evaluate_many(s_raw[:, None], y_raw[:, None])[0]
@@ -561,8 +566,10 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         n_ok = len(reps["t_diw"])
         if n_boot and n_ok < 0.9 * n_boot:
             notes.append(f"DIW found in only {n_ok} of {n_boot} bootstrap replicates")
-    else:
+    elif moving:
         notes.append("ship not dead in the water within the record")
+    else:
+        notes.append("approach from rest: no dead-in-the-water instant sought")
     if base.get("t_term") is not None and terminal_reached:
         te = base["t_term"]
         el = te - t_execute

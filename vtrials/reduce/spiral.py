@@ -18,7 +18,9 @@ Definitions and uncertainty:
 
 * Holds (:func:`rudder_holds`): the rudder record (5-sample running median) is split where it departs
   from the current plateau by more than ``step_threshold`` for ``persist`` samples; plateaus shorter
-  than ``min_hold_s`` are transitions.
+  than ``min_hold_s`` are transitions. The first detected hold is the approach (seed 002: a minute of
+  steady approach before EXECUTE) and is dropped unless ``t_execute`` or the log's ``holds`` say
+  otherwise.
 * Steady window: the last ``window_s`` (120 s) of each hold. Rate = OLS slope of the unwrapped heading
   over the window, SE from the residuals inflated for lag-1 autocorrelation (√((1+ρ)/(1−ρ))).
   Rudder = mean over the window, SE = s/√n likewise inflated, plus the synchro resolution/√12 when
@@ -31,8 +33,9 @@ Definitions and uncertainty:
 * Loop, model-free (:func:`hysteresis_loop` ``direct``): at every rudder setting visited on both
   branches (within ``match_tol``), the branch difference r_down − r_up with its SE; a loop point when
   the difference is positive (the down sweep stays on the starboard branch), exceeds 2 SE and exceeds
-  the practical tolerance 0.003°/s + 3 % of the rate. Width bracket: the loop spans at least the settings with significant differences and at
-  most the interval to the nearest settings beyond them; height: the largest significant difference.
+  the practical tolerance 0.003°/s + 3 % of the rate. Width bracket: the loop spans at least the
+  settings with significant differences and at most the interval to the nearest settings beyond
+  them; height: the largest significant difference.
 * Loop, model (:func:`fit_spiral_curve`): δ(r) = c₀ + c₁r + c₂r² + c₃r³ (the steady-state S-curve,
   e.g. the steady branches of r³ − a r = b δ) by weighted least squares with the effective variance
   σ_δ² + (dδ/dr)² σ_r² (errors in both variables), covariance scaled by the Birge ratio when χ²/ν > 1.

@@ -18,8 +18,11 @@ MSC/Circ.1053 definitions of advance, transfer and tactical diameter):
 2. Steady part (:func:`steady_window`): sliding least-squares rate of turn over windows spanning
    ``rate_window_deg`` of heading; reference rate = slope over the last ``ref_deg`` of heading change;
    the steady part starts at the first window centre after which every window agrees with the
-   reference within max(tol·|r_ref|, 3 SE) (tol = 2 % by default). The record is flagged NOT steady when
-   the steady part spans less than ``min_span_deg`` (90°) of heading.
+   reference within max(tol·|r_ref|, z·SE) (tol = 2 % by default; z Bonferroni-corrected for the
+   number of independent windows, so that gyro noise alone gives a false alarm in 1 % of records).
+   The record is flagged NOT steady when the steady part spans less than ``min_span_deg`` (90°) of
+   heading. A residual transient inside the tolerance biases the steady values by less than
+   tol × (transient time constant / steady duration); that bias is not in the stated SEs.
 3. Drift (:func:`drift_from_pairs`, the seed-002 method used by the report): positions one steady
    turning period T = 2π/|r_ss| apart (i.e. 360° of heading apart in a steady turn) differ only by the
    drift: d_i = (P(t_i + T) − P(t_i))/T for every tracking sample t_i in the steady part whose partner
@@ -53,6 +56,15 @@ Uncertainties (all 1-σ, combined in quadrature as independent sources):
 * drift: its covariance × (t − t_execute)², and, for the fitted circle, the numerical sensitivity of R
   to the drift;
 * EXECUTE position (approach fit) and approach course (SE of the mean heading, lag-1 corrected).
+* distance to the 10° mark (IMO initial turning): chord EXECUTE → P(t₁₀) lengthened to the circular
+  arc with the same change of track direction; SE from the chord-direction variance of the end points;
+* heel: steady = mean roll over the steady part (SE lag-1 corrected); maximum = local quadratic at the
+  sample of largest |roll| (SE from the roll noise); steady rudder likewise from the rudder channel;
+* drift angle: SE of the mean of β_i (lag-1 corrected); the gyro/tracking clock offset is not included.
+
+Rate of turn vs rudder (:func:`rudder_breakdown`, seed 002 Fig. 12): turns grouped by approach speed
+and side; breakdown = the steady rate falls significantly (one-sided z test on the two SEs) when the
+rudder angle grows.
 """
 
 from __future__ import annotations
@@ -448,10 +460,13 @@ def drift_from_heading_pairs(t, north, east, t_heading, heading, t_start: float,
     psi = np.unwrap(psi)
     s = 1.0 if psi[-1] >= psi[0] else -1.0
     f = s * psi
-    # monotone envelope for inversion (noise can make the sampled heading non-monotone)
-    fm = np.maximum.accumulate(f)
-    keep = np.concatenate([[True], np.diff(fm) > 0])
-    fi, ti = fm[keep], th[keep]
+    # smoothed heading for the inversion: 11-sample moving means of (t, ψ) — unbiased for a locally
+    # linear heading (a running maximum of the raw gyro would lead it by ~σ); then strictly monotone
+    k = 11 if len(th) > 40 else 3
+    ker = np.ones(k) / k
+    ts_, fs_ = np.convolve(th, ker, "valid"), np.convolve(f, ker, "valid")
+    keep = np.concatenate([[True], np.diff(np.maximum.accumulate(fs_)) > 0]) & (fs_ >= np.maximum.accumulate(fs_))
+    fi, ti = fs_[keep], ts_[keep]
     max_gap = 3.0 * float(np.median(np.diff(t)))
     dN, dE = [], []
     for i in np.flatnonzero((t >= t_start) & (t <= t_end)):
