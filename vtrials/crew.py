@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections import deque
 
 import numpy as np
@@ -38,6 +39,7 @@ from .units import DEG, KNOT, RPM
 
 EV_COMEX, EV_EXECUTE, EV_FINEX = 1, 2, 3
 MAX_SLICE_S = 60.0  # longest stretch simulated between two looks at the instruments
+FLUSH_ALL_S = 600.0  # instruments the director is not watching take their truth in chunks this long
 TURN_LEAD_DEG = 10.0  # the helm eases the turn this far before the new course and meets the swing
 MAX_BALANCE_TRIMS = 4
 
@@ -196,6 +198,7 @@ class Crew:
         self._recent: deque = deque()
         self._row_count = 0
         self._unflushed = 0
+        self.instrument_wall_s = 0.0  # wall time spent in the instruments (benchmarks)
         self._t_change = 0.0
         self._final_phase = 0
         self._course = 0.0
@@ -250,8 +253,10 @@ class Crew:
         cols = self.columns(rows)
         self.iset.push(cols)
         self._unflushed += rows.shape[0]
-        if self._unflushed * self.sim.dt * self.sim.record_every >= MAX_SLICE_S - 1e-9:
+        if self._unflushed * self.sim.dt * self.sim.record_every >= FLUSH_ALL_S - 1e-9:
+            t0 = time.perf_counter()
             self.iset.flush()
+            self.instrument_wall_s += time.perf_counter() - t0
             self._unflushed = 0
         k0 = (-self._row_count) % self.truth_every
         self.truth_rows.append(rows[k0::self.truth_every])
@@ -275,7 +280,9 @@ class Crew:
         def get(name, ch):
             if name is None:
                 return None
+            w0 = time.perf_counter()
             t, c = self.iset.window(name, t0)
+            self.instrument_wall_s += time.perf_counter() - w0
             return (t, c[ch])
         def torque(name):  # less the zero logged at the pre-trial zero setting
             d = get(name, "torque")

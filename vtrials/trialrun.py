@@ -95,7 +95,11 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     iset.reset()
     crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)
     crew.run_agenda()
+    t_ins = time.perf_counter()
+    iset.flush()
+    crew.instrument_wall_s += time.perf_counter() - t_ins
     timings["simulate_s"] = time.perf_counter() - t_wall
+    timings["instruments_s"] = crew.instrument_wall_s
     t1 = time.perf_counter()
     calm = calm_water_truth(scn, crew)
     timings["calm_water_s"] = time.perf_counter() - t1

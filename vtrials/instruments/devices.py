@@ -650,6 +650,9 @@ class ShaftTorque(ShaftDevice):
         m = super().meta()
         if hasattr(self, "zero_reading"):
             m["zero_reading_N_m"] = self.zero_reading
+        # the calibration certificate: standard uncertainties of the zero (after zero setting) and scale
+        m["zero_uncertainty_N_m"] = float(self.spec.get("zero_set_fs", 0.0)) * (self.full_scale or 0.0)
+        m["scale_uncertainty"] = _dist(self.spec, "scale")[1]
         return m
 
 

@@ -169,8 +169,8 @@ class InstrumentSet:
             ss = np.random.SeedSequence(self.seed, spawn_key=(SEED_KEY, *self.stream, zlib.crc32(name.encode())))
             dev.reset(np.random.Generator(np.random.PCG64(ss)))
         self._out = {name: [] for name in self.devices}
-        self._pending: list[dict] = []
-        self._seen = {name: 0 for name in self.devices}  # pending chunks each device has processed
+        self._pending: list[dict] = []  # queued truth chunks, consolidated into one at each flush
+        self._seen = {name: 0 for name in self.devices}  # rows of the consolidated chunk each device has seen
 
     def process(self, cols: dict) -> None:
         """Feed one chunk of truth columns (times strictly after the previous chunk's)."""
@@ -186,20 +186,25 @@ class InstrumentSet:
 
     def flush(self, names=None) -> None:
         """Bring the named instruments (default: all) up to the last pushed truth row."""
-        todo = self.devices if names is None else names
-        for name in todo:
+        if not self._pending:
+            return
+        if len(self._pending) > 1:  # one concatenation, shared by every device flushed from now on
+            first = self._pending[0]
+            self._pending = [{c: np.concatenate([p[c] for p in self._pending]) for c in first}]
+        cols = self._pending[0]
+        n = cols["t"].size
+        for name in (self.devices if names is None else names):
             k = self._seen[name]
-            if k >= len(self._pending):
+            if k >= n:
                 continue
-            chunk = self._pending[k:]
-            cols = chunk[0] if len(chunk) == 1 else {c: np.concatenate([p[c] for p in chunk]) for c in chunk[0]}
-            t, ch = self.devices[name].process(cols)
+            part = cols if k == 0 else {c: v[k:] for c, v in cols.items()}
+            t, ch = self.devices[name].process(part)
             if t.size:
                 self._out[name].append((t, ch))
-            self._seen[name] = len(self._pending)
+            self._seen[name] = n
         done = min(self._seen.values())
         if done:
-            del self._pending[:done]
+            self._pending = [{c: v[done:] for c, v in cols.items()}] if done < n else []
             for name in self._seen:
                 self._seen[name] -= done
 

@@ -114,7 +114,9 @@ def run_statistics(rec: Record, run: dict) -> dict:
         st = channels[name]["torque"]
         if st is not None:  # the zero logged at the pre-trial zero setting is removed
             z = float(m.get("zero_reading_N_m", 0.0))
-            st = {**st, "mean": st["mean"] - z, "min": st["min"] - z, "max": st["max"] - z}
+            st = {**st, "mean": st["mean"] - z, "min": st["min"] - z, "max": st["max"] - z,
+                  "calibration_std": math.hypot(float(m.get("zero_uncertainty_N_m", 0.0)),
+                                                float(m.get("scale_uncertainty", 0.0)) * (st["mean"] - z))}
         shafts.setdefault(m["shaft_index"], {})["torque"] = st
     for name in kinds.get("shaft_rpm", []):
         k = rec.meta(name)["shaft_index"]
@@ -126,7 +128,7 @@ def run_statistics(rec: Record, run: dict) -> dict:
             shafts.setdefault(m["shaft_index"], {})["thrust"] = {**st, "mean": st["mean"] - m["nominal_static_load_N"]}
     for name in kinds.get("pitch_indicator", []):
         shafts.setdefault(rec.meta(name)["shaft_index"], {})["pitch"] = channels[name]["pitch"]
-    power = []
+    power, syst = [], []
     for k in sorted(shafts):
         sh = shafts[k]
         if sh.get("torque") and sh.get("rps"):
@@ -135,9 +137,12 @@ def run_statistics(rec: Record, run: dict) -> dict:
                                         Estimate(n["mean"], n["se"], max(n["n_eff"] - 1, 1)))
             sh["power"] = _est(p)
             power.append(p)
+            # calibration (zero and scale of the torsionmeter): common to every run with this meter
+            syst.append(2 * math.pi * n["mean"] * q.get("calibration_std", 0.0))
     out["shafts"] = {str(k): v for k, v in sorted(shafts.items())}
     if power:
         out["power"] = Estimate(sum(p.value for p in power), math.sqrt(sum(p.std ** 2 for p in power)))
+        out["power_calibration_std"] = math.sqrt(sum(x * x for x in syst))
     # relative wind (the first anemometer in name order: the mast)
     anem = kinds.get("anemometer", [])
     if anem:
@@ -255,6 +260,10 @@ def reduce_standardization(rec: Record) -> dict:
         w = CUR.mean_of_means_weights(n)
         P = _mom(p_id, np.hypot(p_id_se, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0))
         P_ms = _mom(p_ms, p_ms_se)
+        # the torsionmeters' calibration uncertainty is common to the spot's runs: added after averaging
+        cal = float(np.mean([r.get("power_calibration_std", 0.0) for r in rs]))
+        P = Estimate(P.value, math.hypot(P.std, cal), P.dof)
+        P_ms = Estimate(P_ms.value, math.hypot(P_ms.std, cal), P_ms.dof)
         rps = _mom([np.mean([float(s["rps"]["mean"]) for s in r["shafts"].values() if s.get("rps")]) for r in rs],
                    [1e-3] * n)
         torque = float(np.dot(w, [sum(s["torque"]["mean"] for s in r["shafts"].values() if s.get("torque"))
@@ -289,7 +298,8 @@ def reduce_standardization(rec: Record) -> dict:
     for r in runs:
         d = {k: v for k, v in r.items() if k not in ("vg", "power")}
         d["vg"] = _est(r["vg"])
-        d["power"] = _est(r.get("power"))
+        pw = r.get("power")
+        d["power"] = None if pw is None else _est(Estimate(pw.value, math.hypot(pw.std, r.get("power_calibration_std", 0.0))))
         runs_out.append(d)
     out = {"kind": "standardization", "tracking": runs[0]["tracking"], "runs": runs_out, "spots": spots,
            "curve": curve, "sigma_run_mps": sigma_run}
