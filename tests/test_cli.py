@@ -5,6 +5,9 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
 
 from vtrials.cli import build_parser, main
 from vtrials.maneuvers import KINDS
@@ -49,3 +52,12 @@ def test_run_writes_results(tmp_path, scenarios_dir, capsys):
             assert isinstance(m["truth"][key], float), key
     assert (out / "trajectory.png").stat().st_size > 10000
     assert (out / "trajectory.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parent.parent / "scenarios").glob("*.toml")),
+                         ids=lambda p: p.name)
+def test_every_shipped_scenario_loads(path):
+    """Every scenario in scenarios/ passes the full input check (model, instruments, agenda)."""
+    from vtrials.scenario import load_scenario
+    scn = load_scenario(path)
+    assert scn.maneuvers or scn.agenda is not None

@@ -341,7 +341,7 @@ def steady_turning_curve(vessel, rps: tuple, pitch: tuple = (), r_max: float | N
                              xtol=1e-12 * prob.U0 / prob.L)
         extra.append(prob.solve(rz, a))
     # insert the added points (skip those on a grid point)
-    tol = 1e-9 * (r_hi - r_lo)
+    tol = 1e-3 * (r_hi - r_lo) / (2 * half)  # closer to a grid point than this: the grid point serves
     for s in extra:
         if np.min(np.abs(rs - s["r"])) > tol:
             pts.append(s)
@@ -355,7 +355,7 @@ def steady_turning_curve(vessel, rps: tuple, pitch: tuple = (), r_max: float | N
     out["success"] = np.array([s["success"] for s in pts])
     out["torque_limited"] = np.array([any(s["torque_limited"]) for s in pts])
     out["added"] = np.array(added)
-    out.update(rps=prob.rps, pitch_ratio=prob.pitch, U0=prob.U0, delta_max=dmax, ddelta_dr0=slope,
+    out.update(rps=prob.rps, pitch_ratio=prob.pitch, U0=base["speed"], delta_max=dmax, ddelta_dr0=slope,
                delta0=base["delta"])
     return out
 
@@ -373,12 +373,13 @@ def steady_turn_at_rudder(vessel, delta: float, rps: tuple, pitch: tuple = (), c
     if curve is None:
         curve = steady_turning_curve(vessel, rps, pitch, dt=dt)
     r = np.asarray(curve["r"])
-    d = np.asarray(curve["delta"])
-    brackets = [i for i in range(len(r) - 1) if (d[i] - delta) * (d[i + 1] - delta) <= 0.0 and d[i] != d[i + 1]]
+    d = np.asarray(curve["delta"], dtype=float) - delta
+    d[np.abs(d) < 1e-10] = 0.0  # the curve ends at ±δ_max to solver precision
+    brackets = [i for i in range(len(r) - 1) if d[i] * d[i + 1] <= 0.0 and d[i] != d[i + 1]]
     # a crossing exactly at a grid point appears in two brackets
     roots = []
     for i in brackets:
-        if roots and d[i] == delta and roots[-1] == i - 1:
+        if roots and d[i] == 0.0 and roots[-1] == i - 1:
             continue
         roots.append(i)
     if not roots:
@@ -397,9 +398,9 @@ def steady_turn_at_rudder(vessel, delta: float, rps: tuple, pitch: tuple = (), c
     keys = ("u", "v", "delta", "z", "roll", "pitch")
     ga = {k: float(curve[k][i]) for k in keys}
     gb = {k: float(curve[k][i + 1]) for k in keys}
-    if d[i] == delta:
+    if d[i] == 0.0:
         return prob.solve(float(r[i]), ga)
-    if d[i + 1] == delta:
+    if d[i + 1] == 0.0:
         return prob.solve(float(r[i + 1]), gb)
 
     def guess(rr):
