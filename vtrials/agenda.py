@@ -28,6 +28,10 @@ from .schema import flag, integer, num, read_table, text, unknown_key, vector
 from .units import DEG, RPM
 
 ORDERS = ("ahead_1_3", "ahead_2_3", "standard", "full", "flank")
+ALL_ORDERS = ORDERS + ("stop", "back_1_3", "back_2_3", "back_full", "back_emergency")
+MANEUVERS = ("turn", "speed_change", "direct_spiral", "reverse_spiral", "zigzag", "pull_out", "backing")
+DIEUDONNE = [15.0, 10.0, 7.5, 5.0, 2.0, 0.0, -2.0, -5.0, -7.5, -10.0, -15.0, -10.0, -7.5, -5.0, -2.0, 0.0, 2.0,
+             5.0, 7.5, 10.0, 15.0]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,6 +72,9 @@ class AgendaRules:
     runout_s: float = num("time allowed after a Williamson turn for the ship to settle before COMEX "
                           "(sets how far the crew runs out past the range before turning)", "s", 0.0, 7200.0,
                           default=240.0)
+    range_radius_m: float = num("maneuvering runs start within this distance of the range centre (the crew "
+                                "steams back first when the ship has wandered off)", "m", 100.0, 1e6,
+                                default=4000.0)
     repeat_unsteady: int = integer("repeats allowed for a run whose data window fails the steadiness "
                                    "check", 0, 5, default=1)
     balance_shafts: bool = flag("balance power between shafts (CP: match r/min, trim pitch until the "
@@ -79,7 +86,7 @@ class AgendaRules:
 @dataclasses.dataclass(frozen=True)
 class TrialHead:
     name: str = text("name of the trial (its record file is records/<name>.nc)")
-    kind: str = text("kind of trial", ("standardization", "log_calibration"))
+    kind: str = text("kind of trial", ("standardization", "log_calibration", "maneuvering"))
     run_s: float = num("length of each measured run (EXECUTE to FINEX)", "s", 10.0, 7200.0, default=180.0)
     autopilot_rudder_deg: float = num("override of the agenda's helm rudder limit for this trial", "deg",
                                       0.0, 35.0, lo_open=True, default=None)
@@ -92,7 +99,8 @@ class TrialHead:
 class Setting:
     """A shaft setting: an engine order, or r/min (and pitch ratio for CP propellers)."""
 
-    order: str = text("engine order (telegraph position)", ORDERS, default=None)
+    order: str = text("engine order (telegraph position; maneuvering runs also stop and astern orders)",
+                      ALL_ORDERS, default=None)
     rpm: float = num("shaft speed", "r/min", 0.0, 5000.0, lo_open=True, default=None)
     pitch: float = num("pitch ratio P/D (controllable pitch)", "", -2.0, 3.0, default=None)
     trailed: str = text("shaft that trails (declutched, free-wheeling)", default=None)
@@ -113,6 +121,45 @@ class SpeedSpec(Setting):
     leg_s: float = num("length of each leg (seed 000: at least 5 min)", "s", 10.0, 7200.0, default=None)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class ManeuverSpec(Setting):
+    """One maneuvering run: the approach setting (order, or rpm and pitch) and the maneuver."""
+
+    type: str = text("maneuver", MANEUVERS)
+    course_deg: float = num("approach course (default: the base course)", "deg", -360.0, 360.0, default=None)
+    course: str = text("approach course relative to the wind (zig-zags: seed 002)", ("into_wind", "with_wind"),
+                       default=None)
+    rudder_deg: float = num("rudder angle (+ starboard): turn, zig-zag, pull-out, backing; speed_change "
+                            "with hard_over or cycle", "deg", -45.0, 45.0, default=None)
+    heading_change_deg: float = num("turn: FINEX after this heading change (seed 002: 540); pull-out: "
+                                    "heading change before the rudder is centred", "deg", 10.0, 3600.0,
+                                    default=None)
+    check_deg: float = num("zig-zag: heading change that shifts the rudder (default |rudder_deg|)", "deg",
+                           0.0, 90.0, lo_open=True, default=None)
+    executes: int = integer("zig-zag: rudder executes incl. the first (5 = two and a half cycles)", 2, 20,
+                            default=5)
+    to_order: str = text("speed_change: engine order given at EXECUTE", ALL_ORDERS, default=None)
+    to_rpm: float = num("speed_change: shaft speed ordered at EXECUTE", "r/min", -5000.0, 5000.0, default=None)
+    to_pitch: float = num("speed_change: pitch ratio ordered at EXECUTE (CP)", "", -2.0, 3.0, default=None)
+    rudder_mode: str = text("speed_change: what the helm does", ("hold_course", "hard_over", "cycle"),
+                            default="hold_course")
+    cycle_s: float = num("speed_change with rudder_mode = cycle: time between rudder shifts", "s", 5.0, 3600.0,
+                         default=30.0)
+    sequence_deg: list = vector("direct spiral: rudder settings in order (default Dieudonné 15 R … 15 L … "
+                                "15 R)", "deg", -45.0, 45.0, default=None)
+    rates_deg_s: list = vector("reverse spiral: rates of turn to hold in order", "deg/s", -20.0, 20.0,
+                               default=None)
+    hold_s: float = num("spirals: data kept at each setting once it is steady (seed 002: ~2 min); pull-out "
+                        "and backing: time after the rudder is centred / put over", "s", 10.0, 7200.0,
+                        default=None)
+    max_setting_s: float = num("spirals: give a setting up (reported) if not steady after this", "s", 60.0,
+                               36000.0, default=1800.0)
+    helm_miss_deg: float = num("spirals: standard deviation of the helmsman's miss of each setting "
+                               "(seed 002: hold what was reached)", "deg", 0.0, 5.0, default=0.3)
+    max_duration_s: float = num("give up (and report it) if FINEX is not reached within this time after "
+                                "EXECUTE", "s", 10.0, 1e5, default=None)
+
+
 @dataclasses.dataclass(frozen=True)
 class Run:
     """One numbered run of the agenda (SI)."""
@@ -130,6 +177,7 @@ class Run:
     leg: int  # pass within its group, 1..
     label: str  # e.g. "spot 3 run 2"
     order: str | None = None  # engine order, when the setting is one
+    params: dict = dataclasses.field(default_factory=dict)  # the maneuver (SI), for maneuvering runs
 
 
 @dataclasses.dataclass
@@ -149,7 +197,8 @@ class Agenda:
         return [r for t in self.trials for r in t.runs]
 
 
-_ITEMS = {"standardization": ("spot", SpotSpec), "log_calibration": ("speed", SpeedSpec)}
+_ITEMS = {"standardization": ("spot", SpotSpec), "log_calibration": ("speed", SpeedSpec),
+          "maneuvering": ("run", ManeuverSpec)}
 
 
 def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None, tuple, str | None]:
@@ -173,7 +222,7 @@ def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None,
         if not cp and pitch is not None:
             raise InputError(f, f"{sec}.pitch", f"{vessel.name} has fixed-pitch propellers")
     for sh in vessel.shafts:
-        if rps > sh.max_rps * (1 + 1e-9):
+        if abs(rps) > sh.max_rps * (1 + 1e-9):
             raise InputError(f, f"{sec}.rpm", f"{rps / RPM:.1f} r/min is above the {sh.max_rps / RPM:.1f} r/min "
                                               f"of shaft {sh.name!r}")
         if pitch is not None and sh.controllable_pitch and not sh.pitch_min <= pitch <= sh.pitch_max:
@@ -252,6 +301,13 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
             isec = f"{sec}.{item_key}[{ii}]"
             spec, _ = read_table(item_cls, itab, f, isec)
             rps, pitch, modes, order = _setting(spec, vessel, f, isec)
+            if kind == "maneuvering":
+                runs.append(_maneuver_run(spec, number + 1, head.name, ii, rps, pitch, modes, order, base, limit,
+                                          vessel, f, isec))
+                number += 1
+                continue
+            if spec.order is not None and spec.order not in ORDERS:
+                raise InputError(f, f"{isec}.order", f"a {kind} run needs an ahead order ({', '.join(ORDERS)})")
             if kind == "standardization":
                 if spec.runs < 2:
                     raise InputError(f, f"{isec}.runs", f"a spot needs at least 2 runs (base course and its "
@@ -285,6 +341,84 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
                                 ii + 1, k + 1, f"{what} {ii + 1} run {k + 1}", order))
         trials.append(Trial(head, runs))
     return Agenda(rules, steadiness, trials)
+
+
+def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pitch, modes, order, base: float,
+                  limit: float, vessel, f: str, sec: str) -> Run:
+    """Check one maneuvering run and convert it to SI."""
+    max_rudder = math.degrees(vessel.max_rudder)
+    need = {"turn": ("rudder_deg",), "zigzag": ("rudder_deg",), "pull_out": ("rudder_deg",),
+            "backing": ("rudder_deg",), "reverse_spiral": ("rates_deg_s",)}
+    for field in need.get(m.type, ()):
+        if getattr(m, field) is None:
+            raise InputError(f, f"{sec}.{field}", f"a {m.type} run needs {field}")
+    if m.rudder_deg is not None and abs(m.rudder_deg) > max_rudder + 1e-9:
+        raise InputError(f, f"{sec}.rudder_deg", f"{m.rudder_deg:g}° is beyond the maximum rudder angle of "
+                                                 f"{vessel.name} ({max_rudder:g}°)")
+    if m.type == "zigzag" and m.rudder_deg == 0:
+        raise InputError(f, f"{sec}.rudder_deg", "a zig-zag needs a non-zero rudder (its sign: the first side)")
+    if m.course is not None and m.course_deg is not None:
+        raise InputError(f, f"{sec}.course", "give course or course_deg, not both")
+    p: dict = {"type": m.type}
+    if m.type == "speed_change":
+        if (m.to_order is None) == (m.to_rpm is None):
+            raise InputError(f, f"{sec}.to_order", "a speed_change needs to_order or to_rpm (not both)")
+        if m.to_order is not None:
+            if m.to_order not in vessel.telegraph:
+                raise InputError(f, f"{sec}.to_order", f"{vessel.name} has no telegraph position {m.to_order!r}")
+            p["to_rps"], p["to_pitch"] = vessel.telegraph[m.to_order]
+            p["to_order"] = m.to_order
+        else:
+            p["to_rps"], p["to_pitch"] = m.to_rpm * RPM, m.to_pitch
+            if any(sh.controllable_pitch for sh in vessel.shafts) and m.to_pitch is None:
+                raise InputError(f, f"{sec}.to_pitch", f"{vessel.name} has controllable-pitch propellers: give "
+                                                       f"to_pitch with to_rpm")
+            for sh in vessel.shafts:
+                if abs(p["to_rps"]) > sh.max_rps * (1 + 1e-9):
+                    raise InputError(f, f"{sec}.to_rpm", f"{m.to_rpm:g} r/min is beyond shaft {sh.name!r}")
+        p["rudder_mode"] = m.rudder_mode
+        p["cycle_s"] = m.cycle_s
+        if m.rudder_mode != "hold_course" and m.rudder_deg is None:
+            raise InputError(f, f"{sec}.rudder_deg", f"rudder_mode {m.rudder_mode!r} needs rudder_deg")
+    if m.type == "direct_spiral":
+        seq = DIEUDONNE if m.sequence_deg is None else list(m.sequence_deg)
+        if len(seq) < 3:
+            raise InputError(f, f"{sec}.sequence_deg", "a spiral needs at least 3 rudder settings")
+        for k, d in enumerate(seq):
+            if abs(d) > max_rudder + 1e-9:
+                raise InputError(f, f"{sec}.sequence_deg[{k}]", f"{d:g}° is beyond the maximum rudder angle "
+                                                                f"({max_rudder:g}°)")
+        p["sequence"] = [d * DEG for d in seq]
+    if m.type == "reverse_spiral":
+        if len(m.rates_deg_s) < 3:
+            raise InputError(f, f"{sec}.rates_deg_s", "a reverse spiral needs at least 3 rates of turn")
+        p["rates"] = [r * DEG for r in m.rates_deg_s]
+    defaults_hold = {"direct_spiral": 120.0, "reverse_spiral": 120.0, "pull_out": 300.0, "backing": 300.0}
+    p["hold_s"] = m.hold_s if m.hold_s is not None else defaults_hold.get(m.type, 0.0)
+    p["max_setting_s"] = m.max_setting_s
+    p["helm_miss"] = m.helm_miss_deg * DEG
+    if m.rudder_deg is not None:
+        p["rudder"] = m.rudder_deg * DEG
+    if m.type == "turn":
+        p["heading_change"] = (m.heading_change_deg or 540.0) * DEG
+    if m.type == "pull_out":
+        p["heading_change"] = (m.heading_change_deg or 360.0) * DEG
+    if m.type == "zigzag":
+        p["check"] = (m.check_deg if m.check_deg is not None else abs(m.rudder_deg)) * DEG
+        p["executes"] = m.executes
+    p["max_duration_s"] = m.max_duration_s
+    p["course_rule"] = m.course
+    heading = (m.course_deg if m.course_deg is not None else base) * DEG
+    what = {"turn": "turn", "speed_change": "speed change", "direct_spiral": "direct spiral",
+            "reverse_spiral": "reverse spiral", "zigzag": "zig-zag", "pull_out": "pull-out",
+            "backing": "backing"}[m.type]
+    extra = "" if m.rudder_deg is None else f" {abs(m.rudder_deg):g}°{'S' if m.rudder_deg > 0 else 'P'}"
+    if m.type == "zigzag":
+        extra = f" {abs(m.rudder_deg):g}/{p['check'] / DEG:g} {'S' if m.rudder_deg > 0 else 'P'}"
+    if m.type == "speed_change":
+        extra = f" → {p.get('to_order') or f'{m.to_rpm:g} r/min'}"
+    return Run(number, trial, m.type, heading, rps, pitch, modes, m.max_duration_s or 0.0, limit * DEG, index + 1, 1,
+               f"{what}{extra}"[:40], order, p)
 
 
 def agenda_keys() -> list[str]:

@@ -55,13 +55,15 @@ def _trend(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     return float(y.mean()), slope * float(t[-1] - t[0])
 
 
-def judge(display: dict, course: float, st, modes: tuple) -> tuple[bool, list[str]]:
+def judge(display: dict, course: float | None, st, modes: tuple, torque_floor: float = 0.0) -> tuple[bool, list[str]]:
     """The director's steadiness verdict over a window of instrument readings.
 
     ``display``: {"rps": [(t, x) per shaft or None], "torque": [(t, x) per shaft or None],
     "heading": (t, ψ) or None, "log": (t, speed) or None}; ``course`` [rad]; ``st`` the agenda's
-    :class:`~vtrials.agenda.Steadiness`; ``modes`` per shaft. Returns (steady, reasons it is not).
-    Shafts that are locked are not judged; a trailing shaft's torque is not judged.
+    :class:`~vtrials.agenda.Steadiness` (``course`` None: heading not judged, e.g. stopped or astern);
+    ``modes`` per shaft; ``torque_floor`` [N m]: the torque tolerance is relative to at least this
+    (a shaft at zero pitch carries almost no torque). Returns (steady, reasons it is not). Shafts that
+    are locked are not judged; a trailing shaft's torque is not judged.
     """
     why = []
     for k, mode in enumerate(modes):
@@ -75,10 +77,10 @@ def judge(display: dict, course: float, st, modes: tuple) -> tuple[bool, list[st
         qd = display["torque"][k]
         if mode == "governed" and qd is not None:
             m, ch = _trend(*qd)
-            if not math.isfinite(ch) or abs(ch) > st.torque_pct / 100 * max(abs(m), 1e-6):
+            if not math.isfinite(ch) or abs(ch) > st.torque_pct / 100 * max(abs(m), torque_floor, 1e-6):
                 why.append(f"shaft {k} torque changing {ch / 1e3:+.2f} kN m over the window")
     hd = display["heading"]
-    if hd is not None and hd[0].size:
+    if course is not None and hd is not None and hd[0].size:
         err = math.atan2(float(np.mean(np.sin(hd[1] - course))), float(np.mean(np.cos(hd[1] - course))))
         if abs(err) > st.heading_deg * DEG:
             why.append(f"heading {math.degrees(err):+.1f}° off the course")
@@ -111,6 +113,9 @@ class Attempt:
     run_notes: list = dataclasses.field(default_factory=list)
     accepted: bool = False
     balance_trims: int = 0
+    completed: bool = True  # maneuvers: FINEX condition reached
+    settings: list = dataclasses.field(default_factory=list)  # spirals: one entry per setting
+    t_release: float = math.nan  # pull-out: rudder centred
 
     def log(self) -> dict:
         r = self.run
@@ -121,7 +126,9 @@ class Attempt:
                 "t_finex": self.t_finex, "approach_steady": self.approach_steady,
                 "approach_notes": self.approach_notes, "run_steady": self.run_steady, "run_notes": self.run_notes,
                 "accepted": self.accepted, "balance_trims": self.balance_trims,
-                "elapsed_s": self.t_finex - self.t_start}
+                "elapsed_s": self.t_finex - self.t_start, "completed": self.completed,
+                "maneuver": {k: v for k, v in r.params.items()}, "settings": self.settings,
+                "t_release": self.t_release}
 
 
 def window_truth(cols: dict, t0: float, t1: float) -> dict:
@@ -197,11 +204,13 @@ class Crew:
         self.truth_rows: list[np.ndarray] = []
         self._recent: deque = deque()
         self._row_count = 0
+        self._keep_from = math.inf  # truth rows after this time are kept for the running attempt
         self._unflushed = 0
         self.instrument_wall_s = 0.0  # wall time spent in the instruments (benchmarks)
         self._t_change = 0.0
         self._final_phase = 0
         self._course = 0.0
+        self._judged_course = 0.0
         L = self.vessel.length
         self._catch_s = 30.0 + 3.0 * L / max(1.0, 0.1 * math.sqrt(9.81 * L))
         ns = sim.ns
@@ -209,6 +218,7 @@ class Crew:
         self.pitch_order = [float(sim.shaftp[k, 16]) for k in range(ns)]  # S_PITCH_DESIGN
         self.modes = ["governed"] * ns
         self._cp = [bool(sim.shaftp[k, S_CP] > 0) for k in range(ns)]
+        self._torque_floor = 0.02 * min(sh.max_torque for sh in self.vessel.shafts)
         # which instrument the director looks at for what
         self._by_kind = {k: iset.of_kind(k) for k in ("shaft_rpm", "shaft_torque", "heading", "em_log",
                                                        "knotmeter", "doppler_log")}
@@ -263,7 +273,8 @@ class Crew:
         self._row_count += rows.shape[0]
         self._recent.append(rows)
         keep_s = self.rules.approach_s + max(r.duration for r in self.agenda.runs) + 2 * MAX_SLICE_S
-        while len(self._recent) > 1 and self._recent[1][0, 0] < self.t - keep_s:
+        keep_from = min(self.t - keep_s, self._keep_from)
+        while len(self._recent) > 1 and self._recent[1][0, 0] < keep_from:
             self._recent.popleft()
 
     def columns(self, rows: np.ndarray) -> dict:
@@ -314,6 +325,15 @@ class Crew:
             self._t_change = self.t
         return changed
 
+    def _order_all(self, rps: float, pitch: float | None, order: str | None) -> None:
+        """An engine order to every governed shaft (a speed change's EXECUTE)."""
+        if order is not None:
+            self.orders.append((self.t, order))
+        for k in range(self.sim.ns):
+            if self.modes[k] == "governed":
+                self._order_shaft(k, rps, pitch if (pitch is not None and self._cp[k]) else self.pitch_order[k],
+                                  "governed")
+
     def _order_shaft(self, k: int, rps: float, pitch: float, mode: str) -> None:
         sim = self.sim
         sim.shaft_cmd[0, k] = rps
@@ -328,7 +348,7 @@ class Crew:
         self._final_phase = len(phases) - 1
 
     def hold(self, course: float, limit: float) -> None:
-        self._course = course
+        self._course = self._judged_course = course
         self._helm([(H.HEADING, course, limit, *self.gains, 0.0)])
 
     def come_to(self, course: float, limit: float) -> None:
@@ -342,7 +362,7 @@ class Crew:
         kp, ki, kd = self.gains
         catch = (H.HEADING, course, dt, kp, ki, kd, self._catch_s)
         final = (H.HEADING, course, limit, kp, ki, kd, 0.0)
-        self._course = course
+        self._course = self._judged_course = course
         if abs(d) < 5 * DEG:
             self._helm([catch, final])
         elif abs(d) > 150 * DEG:
@@ -433,7 +453,8 @@ class Crew:
             if since is not None:
                 t_ok = max(since, self._t_change) + max(r.settle_min_s, self.st.window_s)
                 if self.t >= t_ok - 1e-9:
-                    ok, why = judge(self.display(self.t - self.st.window_s), self._course, self.st, run.modes)
+                    ok, why = judge(self.display(self.t - self.st.window_s), self._judged_course, self.st,
+                                     run.modes, self._torque_floor)
                     if ok:
                         if self._balance(run, att):
                             continue
@@ -470,6 +491,8 @@ class Crew:
 
     # ------------------------------------------------------------------ runs
     def execute(self, run: Run, attempt: int) -> Attempt:
+        if run.kind != "speed":
+            return self.execute_maneuver(run, attempt)
         att = Attempt(run, attempt, math.degrees(run.heading) % 360.0, [], [], list(run.modes), self.t)
         if attempt == 1:
             self.set_shafts(run)
@@ -496,11 +519,96 @@ class Crew:
         self.advance(run.duration)
         att.t_finex = self.t
         self.events.append((self.t, run.number, EV_FINEX))
-        ok, why = judge(self.display(att.t_execute), run.heading, self.st, run.modes)
+        ok, why = judge(self.display(att.t_execute), run.heading, self.st, run.modes, self._torque_floor)
         att.run_steady, att.run_notes = ok, why
         ref = window_truth(self.recent_truth(), att.t_execute, att.t_finex)
         ref.update({"run": run.number, "attempt": attempt})
         self.truth_refs.append(ref)
+        self._runs_done += 1
+        self.attempts.append(att)
+        return att
+
+    # ------------------------------------------------------------------ maneuvering runs
+    def true_wind_from(self) -> float | None:
+        """Direction the wind blows from [rad], from the mast anemometer and the tracked velocity."""
+        anem = self.iset.of_kind("anemometer")
+        if not anem or self._gyro is None or self._track is None:
+            return None
+        t, c = self.iset.window(anem[0], self.t - 60.0)
+        _, g = self.iset.window(self._gyro, self.t - 60.0)
+        tt, fx = self.iset.window(self._track, self.t - 60.0)
+        if t.size < 3 or tt.size < 3:
+            return None
+        psi = math.atan2(np.mean(np.sin(g["heading"])), np.mean(np.cos(g["heading"])))
+        # apparent wind (from-direction) in the world, plus the ship's own velocity over ground
+        a = psi + c["angle"]
+        vn = -np.mean(c["speed"] * np.cos(a))
+        ve = -np.mean(c["speed"] * np.sin(a))
+        from .maneuvering import _rate
+        ok = np.isfinite(fx["north"]) & np.isfinite(fx["east"])
+        gn, ge = _rate(tt[ok], fx["north"][ok]), _rate(tt[ok], fx["east"][ok])
+        # true wind velocity = apparent + ship velocity; it blows from the opposite direction
+        return math.atan2(-(ve + ge), -(vn + gn))
+
+    def back_to_range(self, run: Run) -> None:
+        """If the ship has wandered more than the range radius from the centre, steam back towards it."""
+        pos = self.position()
+        if pos is None:
+            return
+        d = pos - self._center
+        if math.hypot(*d) <= self.rules.range_radius_m:
+            return
+        course = math.atan2(-d[1], -d[0])
+        self.come_to(course, self.vessel.autopilot.rudder_limit_deg * DEG)
+        t_end = self.t + 3600.0
+        while self.t < t_end:
+            self.advance(MAX_SLICE_S)
+            pos = self.position()
+            if pos is None or math.hypot(*(pos - self._center)) < 0.5 * self.rules.range_radius_m:
+                break
+
+    def execute_maneuver(self, run: Run, attempt: int) -> Attempt:
+        from . import maneuvering as MV
+        p = run.params
+        course = run.heading
+        att = Attempt(run, attempt, math.degrees(course) % 360.0, [], [], list(run.modes), self.t)
+        self.set_shafts(run)
+        underway = run.order not in ("stop", "back_1_3", "back_2_3", "back_full", "back_emergency") and run.rps > 0 \
+            and (run.pitch is None or run.pitch > 0.1)
+        if underway:
+            self.back_to_range(run)
+            if p.get("course_rule") in ("into_wind", "with_wind"):
+                w = self.true_wind_from()
+                if w is not None:
+                    course = w if p["course_rule"] == "into_wind" else w + math.pi
+                    course = math.atan2(math.sin(course), math.cos(course))
+                    att.course_deg = math.degrees(course) % 360.0
+            self.come_to(course, run.helm_limit)
+        else:  # stopped or going astern: no course to hold, rudder amidships
+            self._helm([(H.HOLD, 0.0, 0.0)])
+            self._judged_course = None
+            self._t_change = self.t
+        self.settle(run, att)
+        att.rpm_ordered = [x / RPM for x in self.rps_order]
+        att.pitch_ordered = [x if self._cp[k] else None for k, x in enumerate(self.pitch_order)]
+        if underway:
+            self.hold(course, run.helm_limit)
+        att.t_comex = self.t
+        self._keep_from = self.t - 1.0
+        self.events.append((self.t, run.number, EV_COMEX))
+        self.advance(self.rules.approach_s)
+        att.t_execute = self.t
+        self.events.append((self.t, run.number, EV_EXECUTE))
+        MV.execute(self, run, att)
+        att.t_finex = self.t
+        self.events.append((self.t, run.number, EV_FINEX))
+        att.run_steady = True  # the maneuver itself is not judged for steadiness; completion is
+        cols = self.recent_truth()
+        ref = window_truth(cols, att.t_execute, att.t_finex)
+        ref.update(MV.maneuver_truth(run, att, cols))
+        ref.update({"run": run.number, "attempt": attempt})
+        self.truth_refs.append(ref)
+        self._keep_from = math.inf
         self._runs_done += 1
         self.attempts.append(att)
         return att

@@ -15,6 +15,10 @@ Modes (argument list a1..a7; angles in rad, rates in rad/s):
                    when σ(ψ − a3) ≥ a2 the rudder is shifted (σ → −σ); ends after a5 shifts if a5 > 0.
 * ``TURN_UNTIL`` – rudder a1 until the heading has changed by a2 (signed) from the phase start,
                    or, if a4 = 1, from the (unwrapped) base heading a3.
+* ``RATE``       – hold a rate of turn a1 [rad/s] (the reverse spiral, Bech): the autopilot law of
+                   ``HEADING`` tracking a heading that advances at a1 from the phase start,
+                   δ = −(K_p e + K_i ∫e + K_d (r − a1)), e = ψ − ψ_start − a1·t, |δ| ≤ a2,
+                   gains a3, a4, a5; ends after a6 seconds if a6 > 0.
 """
 
 from __future__ import annotations
@@ -24,8 +28,9 @@ import math
 import numba as nb
 import numpy as np
 
-OFF, HOLD, HEADING, ZIGZAG, TURN_UNTIL = 0, 1, 2, 3, 4
-MODE_NAMES = {OFF: "off", HOLD: "hold", HEADING: "heading", ZIGZAG: "zigzag", TURN_UNTIL: "turn_until"}
+OFF, HOLD, HEADING, ZIGZAG, TURN_UNTIL, RATE = 0, 1, 2, 3, 4, 5
+MODE_NAMES = {OFF: "off", HOLD: "hold", HEADING: "heading", ZIGZAG: "zigzag", TURN_UNTIL: "turn_until",
+              RATE: "rate"}
 MAX_PHASES = 8
 NPHASE = 8  # mode + 7 arguments
 # helm state (per ship)
@@ -104,6 +109,18 @@ def helm_step(i, t, psi_u, r, dt, phases, hs, events, ecount, current_order):
                 _log(events, ecount, i, t, EV_ZIGZAG_SHIFT, hs[i, H_NSWITCH])
             order = sigma * ph[1]
             done = ph[5] > 0.0 and hs[i, H_NSWITCH] >= ph[5]
+        elif mode == RATE:
+            e = psi_u - hs[i, H_PSISTART] - ph[1] * elapsed
+            lim = ph[2]
+            u = -(ph[3] * e + ph[4] * hs[i, H_INTEG] + ph[5] * (r - ph[1]))
+            if u > lim:
+                u = lim
+            elif u < -lim:
+                u = -lim
+            else:
+                hs[i, H_INTEG] += e * dt
+            order = u
+            done = ph[6] > 0.0 and elapsed >= ph[6]
         elif mode == TURN_UNTIL:
             order = ph[1]
             target = ph[2]

@@ -24,7 +24,10 @@ the body heave velocity w makes the world vertical velocity zero. ``r`` in this 
 the rate of turn ψ̇ (what a spiral trial measures: Δheading/Δtime); ``r_body`` is the body yaw rate
 (the truth record's ``r``), smaller by cos φ cos θ.
 
-Calm deep water only (no current or wind).
+Functions: :func:`steady_turn` (one rate), :func:`steady_turning_curve` (δ(r) by continuation),
+:func:`steady_turn_at_rudder` (the turn at a rudder angle, on a chosen branch: a direct-spiral
+point) and :func:`hysteresis` (stability, loop width and height). Calm deep water only (no current
+or wind).
 """
 
 from __future__ import annotations
@@ -34,10 +37,10 @@ import math
 import numpy as np
 from scipy import optimize
 
+from .dynamics import quat_to_mat
 from .forces import layout as L
 from .propulsion import GOVERNED, M_INTEG, M_TORQUE, S_FRICTION, S_PMAX, S_PROP, S_QMAX
 from .simulator import ShipState, Simulator, euler_to_quat
-from .dynamics import quat_to_mat
 
 _LIMIT_TOL = 1e-9  # relative margin before a shaft counts as torque/power limited
 
@@ -144,7 +147,7 @@ class _Problem:
         s = self.straight
         return {"u": s.u, "v": 0.0, "delta": 0.0, "z": float(s.z), "roll": float(s.roll), "pitch": float(s.pitch)}
 
-    def solve(self, psidot: float, guess: dict | None = None, tol: float = 1e-10) -> dict:
+    def solve(self, psidot: float, guess: dict | None = None) -> dict:
         g = dict(self.straight_guess() if guess is None else guess)
         limited = [k for k in self.governed if g.get("torque_limited", (False,) * self.ns)[k]]
         for _attempt in range(3):
@@ -215,7 +218,9 @@ def steady_turn(vessel, r: float, rps: tuple, pitch: tuple = (), dt: float = 0.0
     ``rps``: ordered shaft speeds [rev/s] (one value is used for every shaft); ``pitch``: pitch
     ratios (controllable pitch; () = design). ``guess``: a previous result (or a dict with u, v,
     delta, z, roll, pitch) to start from; default the straight-ahead state at this order, good for
-    moderate rates only — follow a curve with :func:`steady_turning_curve` for large ones.
+    moderate rates only — follow a curve with :func:`steady_turning_curve` for large ones. ``dt``
+    is only the evaluating simulator's step (the equilibrium does not depend on it; a time
+    simulation approaches it with a first-order error in dt).
 
     Returns a dict: ``r`` (= ψ̇, as given), ``u``, ``v``, ``w`` [m/s] (body axes, through the
     water), ``delta`` [rad] (every rudder), ``z`` [m], ``roll``, ``pitch`` [rad], ``p``, ``q``,
@@ -285,7 +290,7 @@ def steady_turning_curve(vessel, rps: tuple, pitch: tuple = (), r_max: float | N
     The rate runs from the rate at full port rudder to the rate at full starboard rudder (by
     continuation from straight ahead; with ``r_max`` given, from −r_max to +r_max) through r = 0
     (straight course at the self-propelled speed of the order, :meth:`Simulator.steady_at_order`):
-    (n − 1)/2 equal steps on each side. Parameterising by r is the reverse spiral's (Bech 1968)
+    (n − 1)/2 equal steps on each side (n rounded down to odd). Parameterising by r is the reverse spiral's (Bech 1968)
     and reaches the unstable middle branch. Added points, all solved: the one-sided slopes at
     r = 0 (``ddelta_dr0`` = (left, right); the MMG flow-straightening γ_R changes at β_R = 0, so
     δ(r) can have a kink there), the folds (local extrema of δ(r)) and the zero-rudder rates on the
@@ -427,7 +432,8 @@ def hysteresis(curve: dict) -> dict:
     :func:`steady_turning_curve`'s does; otherwise the discrete extremum and linear interpolation).
     Returns ``unstable``, ``slope0`` (left, right) [s], ``width``, ``delta_star`` (= width/2),
     ``height`` [rad/s], ``centre`` (mid-loop rudder), ``folds`` [(r₁, δ₁), (r₂, δ₂)] and
-    ``r_zero_rudder`` (starboard- and port-branch rates at δ = 0) — the last two None if stable.
+    ``r_zero_rudder`` (rates at δ = 0 on the branch beyond r₂ and on the one below r₁) — the last
+    two None if stable; height and those rates are nan if δ = 0 lies outside the loop.
     """
     r = np.asarray(curve["r"], dtype=float)
     d = np.asarray(curve["delta"], dtype=float)
@@ -466,5 +472,5 @@ def hysteresis(curve: dict) -> dict:
             break
     out.update(width=float(width), delta_star=float(width / 2.0), height=float(abs(r_stbd - r_port)),
                centre=float((d1 + d2) / 2.0), folds=[(float(r[i1]), float(d1)), (float(r[i2]), float(d2))],
-               r_zero_rudder=(float(max(r_port, r_stbd)), float(min(r_port, r_stbd))))
+               r_zero_rudder=(float(r_stbd), float(r_port)))
     return out
