@@ -25,6 +25,7 @@ the truth references (:func:`maneuver_truth`).
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -60,16 +61,39 @@ def _track_speed(crew, t0: float, t1: float) -> float:
     return math.hypot(_rate(t[m], c["north"][m]), _rate(t[m], c["east"][m]))
 
 
-def rate_steady(crew, window_s: float = 60.0, tol_abs: float = 0.01 * DEG, tol_rel: float = 0.03) -> tuple[bool, float]:
-    """Is the gyro's rate of turn steady? Rates over the last two windows agree within
-    max(tol_abs, tol_rel·|r|). Returns (steady, latest rate)."""
-    t, psi = _gyro(crew, crew.t - 2 * window_s)
+def _two_windows(t: np.ndarray, x: np.ndarray, window_s: float, stat) -> tuple[float, float] | None:
     if t.size < 10 or t[-1] - t[0] < 1.9 * window_s:
-        return False, math.nan
+        return None
     mid = t[-1] - window_s
-    r1 = _rate(t[t < mid], psi[t < mid])
-    r2 = _rate(t[t >= mid], psi[t >= mid])
-    return abs(r2 - r1) <= max(tol_abs, tol_rel * abs(r2)), r2
+    return stat(t[t < mid], x[t < mid]), stat(t[t >= mid], x[t >= mid])
+
+
+def spiral_steady(crew, reverse: bool, tol_rate: float = 0.002 * DEG, tol_rudder: float = 0.05 * DEG,
+                  tol_rel: float = 0.02) -> bool:
+    """Is a spiral setting steady, judged as the director would over two consecutive windows of the
+    agenda's steadiness length (at least 2 min)? Direct spiral: the gyro's rate of turn agrees within
+    max(``tol_rate``, ``tol_rel``·|r|). Reverse spiral — the helm holds the rate, so the rudder is
+    what settles: the mean rudder angle agrees within max(``tol_rudder``, ``tol_rel``·|δ|). Both: the
+    log speed no longer changing (the agenda's speed tolerance)."""
+    W = max(120.0, crew.st.window_s)
+    if not reverse:
+        t, psi = _gyro(crew, crew.t - 2 * W)
+        rr = _two_windows(t, psi, W, _rate)
+        if rr is None or abs(rr[1] - rr[0]) > max(tol_rate, tol_rel * abs(rr[1])):
+            return False
+    else:
+        rud = crew.iset.of_kind("rudder")
+        if rud:
+            t, c = crew.iset.window(rud[0], crew.t - 2 * W)
+            dd = _two_windows(t, c["angle"], W, lambda a, b: float(np.mean(b)))
+            if dd is None or abs(dd[1] - dd[0]) > max(tol_rudder, tol_rel * abs(dd[1])):
+                return False
+    log = crew.display(crew.t - 2 * W)["log"]
+    if log is not None and log[0].size:
+        vv = _two_windows(log[0], log[1], W, lambda a, b: float(np.mean(b)))
+        if vv is None or abs(vv[1] - vv[0]) > crew.st.speed_kn * KNOT:
+            return False
+    return True
 
 
 def execute(crew, run: Run, att) -> None:
@@ -93,7 +117,12 @@ def execute(crew, run: Run, att) -> None:
                 break
     elif kind == "zigzag":
         side = 1.0 if p["rudder"] > 0 else -1.0
-        crew._helm([(H.ZIGZAG, abs(p["rudder"]), p["check"], psi0, side, float(p["executes"])),
+        # the helmsman counts the heading change from the ordered course, not from where the heading
+        # happened to be at EXECUTE
+        course = math.radians(att.course_deg)
+        base = psi0 + math.atan2(math.sin(course - psi0), math.cos(course - psi0))
+        att.base_offset = base - psi0
+        crew._helm([(H.ZIGZAG, abs(p["rudder"]), p["check"], base, side, float(p["executes"])),
                     (H.HOLD, 0.0, 0.0)])
         while crew.t - t_exec < limit:
             crew.advance(LOOK_S)
@@ -141,8 +170,7 @@ def execute(crew, run: Run, att) -> None:
                 crew.advance(30.0)
                 if crew.t - t_set < 120.0:
                     continue
-                ok, _ = rate_steady(crew)
-                if ok:
+                if spiral_steady(crew, reverse=(kind == "reverse_spiral")):
                     steady, t_steady = True, crew.t
                     crew.advance(p["hold_s"])
                     break
@@ -203,8 +231,10 @@ def maneuver_truth(run: Run, att, cols: dict) -> dict:
             out["residual_rate_dps"] = float(np.degrees(np.mean(c["r"][m])))
             out["t_release"] = tr
     elif kind == "zigzag":
+        off = getattr(att, "base_offset", 0.0)  # ordered course − heading at EXECUTE
         out.update(TM.zigzag(c["t"], c["heading"], rudder_deg=abs(math.degrees(p["rudder"])),
-                             heading_deg=math.degrees(p["check"]), first_side=1 if p["rudder"] > 0 else -1))
+                             heading_deg=math.degrees(p["check"]), first_side=1 if p["rudder"] > 0 else -1,
+                             base=float(c["heading"][0]) + off))
         out["approach_speed_mps"] = float(math.hypot(c["u_r"][0], c["v_r"][0]))
     elif kind == "speed_change":
         out.update(TM.speed_change(c["t"], c["x_w"], c["y_w"], c["heading"], c["u_r"], c["v_r"]))
@@ -215,8 +245,12 @@ def maneuver_truth(run: Run, att, cols: dict) -> dict:
         for s in getattr(att, "settings", []):
             t0 = s["t_end"] - p["hold_s"] if s["steady"] else s["t_end"] - 120.0
             m = (c["t"] >= t0) & (c["t"] <= s["t_end"])
-            pts.append({"index": s["index"], "rate": float(np.mean(c["r"][m])) if m.any() else math.nan,
-                        "rudder": float(np.mean(c["rudder_0"][m])) if m.any() else math.nan,
+            # rate of turn = rate of change of heading (not the body yaw rate, which a heeled ship
+            # turning steadily has smaller by cos φ); rudder = mean of all rudders
+            rate = float(np.polyfit(c["t"][m], c["heading"][m], 1)[0]) if np.count_nonzero(m) > 2 else math.nan
+            rud = np.mean([c[k][m] for k in c if re.fullmatch(r"rudder_\d+", k)], axis=0) if m.any() else None
+            pts.append({"index": s["index"], "rate": rate,
+                        "rudder": float(np.mean(rud)) if rud is not None else math.nan,
                         "speed": float(np.mean(np.hypot(c["u_r"][m], c["v_r"][m]))) if m.any() else math.nan,
                         "steady": s["steady"], "t0": t0, "t1": s["t_end"]})
         out["points"] = pts

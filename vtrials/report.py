@@ -32,8 +32,10 @@ def _save(fig, path: Path) -> None:
 
 
 def _fmt(x, nd=2):
-    if x is None or (isinstance(x, float) and not math.isfinite(x)):
-        return "–"
+    if isinstance(x, dict):  # an Estimate
+        x = x.get("value")
+    if x is None or isinstance(x, str) or (isinstance(x, float) and not math.isfinite(x)):
+        return "–" if x is None or not isinstance(x, str) else x
     return f"{x:.{nd}f}"
 
 
@@ -205,6 +207,202 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
     return L + [""]
 
 
+# ----------------------------------------------------------------------------------- maneuvering
+def _truth_cols(res):
+    crew = res.crew
+    rows = np.concatenate(crew.truth_rows, axis=0)
+    return crew.columns(rows)
+
+
+def _mv_figures(tr: dict, res, out: Path) -> list[str]:
+    plt = _fig()
+    red, err = tr["reduced"], tr["error"]
+    name = tr["name"]
+    files = []
+    cols = _truth_cols(res)
+    tt = cols["t"]
+    runs = red["runs"]
+    turns = [r for r in runs if r["type"] == "turn" and r.get("advance")]
+    if turns:
+        from .records import open_record
+        from .reduce.maneuvering import Channels
+        ch = Channels(open_record(out / tr["record"]))
+        n = len(turns)
+        nc = min(6, n)
+        nr = int(math.ceil(n / nc))
+        fig, axes = plt.subplots(nr, nc, figsize=(2.6 * nc, 2.6 * nr), squeeze=False)
+        for ax, r in zip(axes.ravel(), turns):
+            te = r["t_execute"]
+            w = ch.window(te, r["t_finex"])
+            dn = r["drift"]["north"]["value"] if r.get("drift") else 0.0
+            de = r["drift"]["east"]["value"] if r.get("drift") else 0.0
+            psi0 = r["approach_course"]["value"]
+            c, s_ = math.cos(psi0), math.sin(psi0)
+            n0 = np.interp(te, w["t"], w["north"]) if w["t"].size else 0.0
+            e0 = np.interp(te, w["t"], w["east"]) if w["t"].size else 0.0
+            nn = w["north"] - dn * (w["t"] - te) - n0
+            ee = w["east"] - de * (w["t"] - te) - e0
+            ax.plot(-nn * s_ + ee * c, nn * c + ee * s_, "C0-", lw=1, label="reduced (drift-corrected)")
+            m = (tt >= te) & (tt <= r["t_finex"])
+            xw, yw = cols["x_w"][m] - np.interp(te, tt, cols["x_w"]), cols["y_w"][m] - np.interp(te, tt, cols["y_w"])
+            ax.plot(-xw * s_ + yw * c, xw * c + yw * s_, "k--", lw=0.8, label="true track through the water")
+            side = 1 if r["turn_side"] > 0 else -1
+            ax.plot([side * r["transfer"]["value"]], [r["advance"]["value"]], "C1o", ms=4)
+            if r.get("tactical_diameter"):
+                ax.axvline(side * r["tactical_diameter"]["value"], color="C1", lw=0.6, ls=":")
+            ax.set_aspect("equal")
+            ax.set_title(r["label"], fontsize=8)
+            ax.tick_params(labelsize=6)
+        for ax in axes.ravel()[n:]:
+            ax.axis("off")
+        axes[0, 0].legend(fontsize=6)
+        fig.suptitle(f"{name}: drift-corrected turning tracks (across / along the approach course, m); "
+                     f"dot: advance & transfer, dotted: tactical diameter", fontsize=9)
+        f = f"{name}_turns.png"
+        _save(fig, out / f)
+        files.append(f)
+        # rate of turn against rudder, reduced vs true
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        truth = {x["run"]: x for x in tr["truth"]["runs"] if x}
+        for k, r in enumerate(turns):
+            rd = r["rudder_steady"]["value"] if r.get("rudder_steady") else r["rudder_ordered"]
+            rt = r["steady_rate"]
+            ax.errorbar(math.degrees(rd), math.degrees(rt["value"]), yerr=1.96 * math.degrees(rt["std"]), fmt="o",
+                        color="C0", ms=4, label="reduced" if k == 0 else None)
+            t_ = truth.get(r["run"], {})
+            if t_.get("steady_rate_of_turn_dps") is not None:
+                ax.plot(t_.get("rudder_deg", math.degrees(rd)), math.copysign(t_["steady_rate_of_turn_dps"], rd), "kx",
+                        label="true" if k == 0 else None)
+        ax.set_xlabel("rudder [deg]")
+        ax.set_ylabel("steady rate of turn [deg/s]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        f = f"{name}_rate_vs_rudder.png"
+        _save(fig, out / f)
+        files.append(f)
+    sc = [r for r in runs if r["type"] == "speed_change" and r.get("curve")]
+    if sc:
+        fig, axes = plt.subplots(1, len(sc), figsize=(4.2 * len(sc), 3.4), squeeze=False)
+        for ax, r in zip(axes[0], sc):
+            cv = r["curve"]
+            te = r["t_execute"]
+            ax.plot(np.array(cv["t"]) - te, np.array(cv["speed"]) / KNOT, "C0-", label="reduced (fit)")
+            m = (tt >= te - 60) & (tt <= r["t_finex"])
+            ax.plot(tt[m] - te, np.sign(cols["u_r"][m]) * np.hypot(cols["u_r"][m], cols["v_r"][m]) / KNOT, "k--", lw=0.8,
+                    label="true speed through water")
+            if r.get("time_to_dead_in_water"):
+                ax.axvline(r["time_to_dead_in_water"]["value"], color="C1", lw=0.8, label="reduced time to DIW")
+            ax.axhline(0, color="0.6", lw=0.5)
+            ax.set_title(r["label"], fontsize=8)
+            ax.set_xlabel("time after EXECUTE [s]")
+            ax.set_ylabel("speed [kn]")
+            ax.grid(alpha=0.3)
+        axes[0, 0].legend(fontsize=7)
+        f = f"{name}_reach.png"
+        _save(fig, out / f)
+        files.append(f)
+    zz = [r for r in runs if r["type"] == "zigzag" and "error" not in r]
+    if zz:
+        from .records import open_record
+        from .reduce.maneuvering import Channels
+        ch = Channels(open_record(out / tr["record"]))
+        fig, axes = plt.subplots(len(zz), 1, figsize=(9, 2.6 * len(zz)), squeeze=False)
+        for ax, r in zip(axes[:, 0], zz):
+            te = r["t_execute"]
+            w = ch.window(te - 30, r["t_finex"])
+            psi0 = r["approach_heading"]["value"] if isinstance(r.get("approach_heading"), dict) else w["heading"][0]
+            ax.plot(w["t_heading"] - te, np.degrees(w["heading"] - psi0), "C0-", lw=1, label="gyro heading − approach")
+            ax.plot(w["t_rudder"] - te, np.degrees(w["rudder"]), "C1-", lw=0.8, label="rudder synchro")
+            m = (tt >= te - 30) & (tt <= r["t_finex"])
+            ax.plot(tt[m] - te, np.degrees(cols["heading"][m] - np.interp(te, tt, cols["heading"])), "k--", lw=0.7,
+                    label="true heading change")
+            ax.set_title(r["label"], fontsize=8)
+            ax.grid(alpha=0.3)
+            ax.set_ylabel("deg")
+        axes[-1, 0].set_xlabel("time after EXECUTE [s]")
+        axes[0, 0].legend(fontsize=7, ncol=3)
+        f = f"{name}_zigzag.png"
+        _save(fig, out / f)
+        files.append(f)
+    sp = [r for r in runs if r["type"] in ("direct_spiral", "reverse_spiral") and r.get("points")]
+    if sp:
+        fig, axes = plt.subplots(1, len(sp), figsize=(5.5 * len(sp), 4.2), squeeze=False)
+        for ax, r in zip(axes[0], sp):
+            st = res.calm_water.get(f"spiral_run_{r['run']}")
+            if st:
+                ax.plot(np.degrees(st["curve"]["delta"]), np.degrees(st["curve"]["r"]), "k-", lw=1,
+                        label="true steady turns (model equations)")
+            for q in r["points"]:
+                ok = q.get("steady", True)
+                ax.errorbar(math.degrees(q["rudder"]["value"]), math.degrees(q["rate"]["value"]),
+                            xerr=1.96 * math.degrees(q["rudder"]["std"]), yerr=1.96 * math.degrees(q["rate"]["std"]),
+                            fmt="o" if ok else "x", color="C0" if ok else "C3", ms=4)
+            ax.axhline(0, color="0.7", lw=0.5)
+            ax.axvline(0, color="0.7", lw=0.5)
+            ax.set_xlabel("rudder [deg]")
+            ax.set_ylabel("rate of turn [deg/s]")
+            ax.set_title(f"{r['label']} (x: never steady)", fontsize=8)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+        f = f"{name}_spiral.png"
+        _save(fig, out / f)
+        files.append(f)
+    return files
+
+
+def _mv_markdown(tr: dict, figs: list[str]) -> list[str]:
+    red, err = tr["reduced"], tr["error"]
+    sm = err["summary"]
+    L = [f"## {tr['name']} (maneuvering)", "",
+         f"Tracking: `{red['tracking']}`. Runs: {sm['runs']}. Advance / tactical diameter: largest error "
+         f"{_fmt(100 * sm['max_rel_error_advance_tactical'], 2)} %, intervals cover "
+         f"{_fmt(100 * sm['advance_tactical_coverage'] if sm['advance_tactical_coverage'] is not None else None, 0)} %; "
+         f"stopping time / reach: largest error {_fmt(100 * sm['max_rel_error_stop_time_reach'], 2)} %; "
+         f"overshoots: largest error {_fmt(sm['max_abs_overshoot_error_deg'], 3)}°.", ""]
+    L += [f"![{f}]({f})" for f in figs] + [""]
+    rows = ["| run | maneuver | quantity | reduced | ± (95 %) | true | error | covered |", "|---|---|---|---|---|---|---|---|"]
+    unit = {"advance": ("m", 1), "transfer": ("m", 1), "tactical_diameter": ("m", 1), "steady_diameter": ("m", 1),
+            "steady_speed": ("kn", 1 / KNOT), "steady_rate": ("°/s", 180 / math.pi), "heel_max": ("°", 180 / math.pi),
+            "approach_speed": ("kn", 1 / KNOT), "time_to_dead_in_water": ("s", 1), "track_reach": ("m", 1),
+            "head_reach": ("m", 1), "lateral_deviation": ("m", 1), "terminal_speed": ("kn", 1 / KNOT),
+            "time_to_terminal_speed": ("s", 1), "time_to_90_percent": ("s", 1), "first_overshoot": ("°", 180 / math.pi),
+            "second_overshoot": ("°", 180 / math.pi), "initial_turning_time": ("s", 1), "time_to_check_yaw": ("s", 1),
+            "period": ("s", 1)}
+    for r in err["runs"]:
+        for k, c in r.items():
+            if not isinstance(c, dict) or "truth" not in c or k not in unit or c.get("reduced") is None:
+                continue
+            u, f = unit[k]
+            rows.append(f"| {r['run']} | {r['label']} | {k} [{u}] | {_fmt(c['reduced'] * f, 2)} | "
+                        f"{_fmt(1.96 * c['std'] * f if c.get('std') is not None else None, 2)} | {_fmt(c['truth'] * f, 2)} | "
+                        f"{_fmt(c['error'] * f, 2)} | {c['covered']} |")
+        if "loop" in r:
+            lp = r["loop"]
+            rw = lp.get("reduced_width")
+            rwv = rw.get("value") if isinstance(rw, dict) else None
+            tw = lp.get("true_width")
+            rows.append(f"| {r['run']} | {r['label']} | loop width [°] | "
+                        f"{_fmt(math.degrees(rwv) if rwv is not None else None, 2)} | | "
+                        f"{_fmt(math.degrees(tw) if tw is not None else None, 2)} | | "
+                        f"{lp.get('width', {}).get('covered')} |")
+    L += rows + [""]
+    imo = red.get("imo") or {}
+    if imo.get("verdicts"):
+        L += [f"IMO MSC.137(76) (L = {imo['length_m']:.1f} m, V = {imo['speed_mps'] / KNOT:.2f} kn):", "",
+              "| criterion | value | limit | passed | margin | true value | true verdict |", "|---|---|---|---|---|---|---|"]
+        truth = tr["truth"].get("imo") or {}
+        for k, v in imo["verdicts"].items():
+            if not isinstance(v, dict) or "limit" not in v:
+                continue
+            tv = truth.get(k, {}) if isinstance(truth, dict) else {}
+            val = v["value"]["value"] if isinstance(v["value"], dict) else v["value"]
+            tval = tv.get("value", {}).get("value") if isinstance(tv.get("value"), dict) else tv.get("value")
+            L.append(f"| {v['criterion']} | {_fmt(val, 3)} | {_fmt(v['limit'], 3)} | {v['passed']} | "
+                     f"{_fmt(v.get('margin'), 3)} | {_fmt(tval, 3)} | {tv.get('passed')} |")
+        L.append("")
+    return L
+
+
 # ----------------------------------------------------------------------------------- the document
 def write_report(doc: dict, res, out: Path) -> None:
     """report.md and its figures for an agenda run (``doc`` is results.json's content)."""
@@ -226,5 +424,8 @@ def write_report(doc: dict, res, out: Path) -> None:
         elif tr["kind"] == "log_calibration":
             figs = _lc_figures(tr, out)
             L += _lc_markdown(tr, figs)
+        elif tr["kind"] == "maneuvering":
+            figs = _mv_figures(tr, res, out)
+            L += _mv_markdown(tr, figs)
     with atomic_path(out / "report.md") as tmp:
         tmp.write_text("\n".join(L) + "\n")

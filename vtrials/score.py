@@ -148,9 +148,162 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
             "error": {"summary": summary, "legs": legs, "current": cur_err, "calibrations": cals}}
 
 
+def _rel(c: dict) -> dict:
+    """Add the relative error to a comparison."""
+    if c.get("error") is not None and c.get("truth"):
+        c["rel_error"] = c["error"] / abs(c["truth"])
+    return c
+
+
+def _abs_est(d: dict | None) -> dict | None:
+    return None if d is None else {**d, "value": abs(d["value"])}
+
+
+# (reduced key, truth key, truth scale to SI, compare magnitudes)
+TURN_KEYS = [("advance", "advance_m", 1.0, False), ("transfer", "transfer_m", 1.0, False),
+             ("tactical_diameter", "tactical_diameter_m", 1.0, False),
+             ("steady_diameter", "steady_turning_diameter_m", 1.0, False),
+             ("steady_speed", "steady_speed_mps", 1.0, False),
+             ("steady_rate", "steady_rate_of_turn_dps", math.pi / 180, True),
+             ("heel_max", "heel_max_deg", math.pi / 180, True), ("approach_speed", "approach_speed_mps", 1.0, False)]
+REACH_KEYS = [("time_to_dead_in_water", "stop_time_to_dead_in_water_s", 1.0, False),
+              ("track_reach", "stop_track_reach_m", 1.0, False), ("head_reach", "stop_head_reach_m", 1.0, False),
+              ("lateral_deviation", "stop_lateral_deviation_m", 1.0, False),
+              ("terminal_speed", "terminal_speed_mps", 1.0, False),
+              ("time_to_terminal_speed", "time_to_terminal_speed_s", 1.0, False),
+              ("time_to_90_percent", "time_to_90_percent_s", 1.0, False)]
+ZIGZAG_KEYS = [("first_overshoot", "first_overshoot_deg", math.pi / 180, False),
+               ("second_overshoot", "second_overshoot_deg", math.pi / 180, False),
+               ("initial_turning_time", "initial_turning_time_s", 1.0, False),
+               ("time_to_check_yaw", "time_to_check_yaw_s", 1.0, False), ("period", "period_s", 1.0, False)]
+
+
+def _compare(red: dict, tru: dict, keys) -> dict:
+    out = {}
+    for rk, tk, f, mag in keys:
+        if red.get(rk) is None or tru.get(tk) is None:
+            continue
+        rv = _abs_est(red[rk]) if mag else red[rk]
+        tv = abs(tru[tk] * f) if mag else tru[tk] * f
+        out[rk] = _rel(_cmp(rv, tv))
+    return out
+
+
+def _spiral_points(red_pts: list, true_pts: list) -> list:
+    """Match reduced spiral points to the true per-setting means by their data windows."""
+    out = []
+    for q in red_pts:
+        win = q.get("hold") or q.get("window")
+        if not win or not true_pts:
+            continue
+        tm = 0.5 * (win[0] + win[1])
+        tp = min(true_pts, key=lambda x: abs(0.5 * (x["t0"] + x["t1"]) - tm))
+        out.append({"rudder": _cmp(q["rudder"], tp["rudder"]), "rate": _cmp(q["rate"], tp["rate"]),
+                    "steady": q.get("steady", True), "true_steady": tp["steady"]})
+    return out
+
+
+def score_maneuvering(reduced: dict, res, name: str) -> dict:
+    crew = res.crew
+    truth = _truth_of(crew, name)
+    runs = []
+    worst = {"turn_rel": 0.0, "reach_rel": 0.0, "overshoot_deg": 0.0}
+    cover = []
+    for r in reduced["runs"]:
+        tr = truth.get(r["run"], {})
+        d = {"run": r["run"], "type": r["type"], "label": r.get("label")}
+        if "error" in r:
+            d["reduction_error"] = r["error"]
+        elif r["type"] in ("turn", "pull_out"):
+            d.update(_compare(r, tr, TURN_KEYS))
+            if r.get("drift") and tr.get("drift"):
+                d["drift_north"] = _cmp(r["drift"]["north"], tr["drift"][0])
+                d["drift_east"] = _cmp(r["drift"]["east"], tr["drift"][1])
+            for k in ("advance", "tactical_diameter"):
+                if k in d and d[k].get("rel_error") is not None:
+                    worst["turn_rel"] = max(worst["turn_rel"], abs(d[k]["rel_error"]))
+                    cover.append(d[k]["covered"])
+        elif r["type"] == "speed_change":
+            d.update(_compare(r, tr, REACH_KEYS))
+            for k in ("time_to_dead_in_water", "track_reach"):
+                if k in d and d[k].get("rel_error") is not None:
+                    worst["reach_rel"] = max(worst["reach_rel"], abs(d[k]["rel_error"]))
+        elif r["type"] == "zigzag":
+            d.update(_compare(r, tr, ZIGZAG_KEYS))
+            for k in ("first_overshoot", "second_overshoot"):
+                if k in d and d[k].get("error") is not None:
+                    worst["overshoot_deg"] = max(worst["overshoot_deg"], abs(math.degrees(d[k]["error"])))
+        elif r["type"] in ("direct_spiral", "reverse_spiral"):
+            d["points"] = _spiral_points(r.get("points", []), tr.get("points", []))
+            st = res.calm_water.get(f"spiral_run_{r['run']}")
+            loop = r.get("loop") or {}
+            if st is not None:
+                h = st["hysteresis"]
+                d["loop"] = {"true_unstable": h["unstable"], "true_width": h["width"], "true_height": h["height"],
+                             "reduced_width": loop.get("width"), "reduced_height": loop.get("height"),
+                             "reduced_verdict": loop.get("verdict")}
+                if isinstance(loop.get("width"), dict):
+                    d["loop"]["width"] = _cmp(loop["width"], h["width"])
+                if isinstance(loop.get("height"), dict) and h["height"] == h["height"]:
+                    d["loop"]["height"] = _cmp(loop["height"], h["height"])
+        elif r["type"] == "backing":
+            if tr.get("heading_change_deg") is not None and r.get("heading_change") is not None:
+                d["heading_change"] = {"reduced": r["heading_change"], "truth": math.radians(tr["heading_change_deg"])}
+        runs.append(d)
+    imo = reduced.get("imo") or {}
+    imo_truth = {}
+    if imo:
+        from .reduce import imo as IMO
+        L = imo["length_m"]
+        t_turns = [truth[r["run"]] for r in reduced["runs"] if r["type"] == "turn" and r.get("rudder_ordered")
+                   and abs(r["rudder_ordered"]) >= math.radians(34.0) and r["run"] in truth]
+        kw = {}
+        if t_turns:
+            kw["advance_m"] = max(t.get("advance_m", 0.0) for t in t_turns)
+            kw["tactical_diameter_m"] = max(t.get("tactical_diameter_m", 0.0) for t in t_turns)
+        z10 = [truth[r["run"]] for r in reduced["runs"] if r["type"] == "zigzag"
+               and abs(abs(r.get("rudder_ordered", 0)) - math.radians(10)) < 1e-6 and r["run"] in truth]
+        z20 = [truth[r["run"]] for r in reduced["runs"] if r["type"] == "zigzag"
+               and abs(abs(r.get("rudder_ordered", 0)) - math.radians(20)) < 1e-6 and r["run"] in truth]
+        if z10:
+            kw["first_overshoot_10_rad"] = math.radians(max(t.get("first_overshoot_deg", 0.0) for t in z10))
+            kw["second_overshoot_10_rad"] = math.radians(max(t.get("second_overshoot_deg", 0.0) for t in z10))
+        if z20:
+            kw["first_overshoot_20_rad"] = math.radians(max(t.get("first_overshoot_deg", 0.0) for t in z20))
+        stops = [truth[r["run"]] for r in reduced["runs"] if r["type"] == "speed_change"
+                 and str(r.get("to_order", "")).startswith("back") and r["run"] in truth]
+        if stops and any("stop_track_reach_m" in t for t in stops):
+            kw["stopping_track_reach_m"] = max(t.get("stop_track_reach_m", 0.0) for t in stops)
+        if kw:
+            imo_truth = json_ready(IMO.assess(L, imo["speed_mps"], **kw))
+    summary = {"runs": len(runs), "max_rel_error_advance_tactical": worst["turn_rel"],
+               "advance_tactical_coverage": (sum(bool(c) for c in cover) / len(cover)) if cover else None,
+               "max_rel_error_stop_time_reach": worst["reach_rel"],
+               "max_abs_overshoot_error_deg": worst["overshoot_deg"]}
+    return {"reduced": reduced, "truth": {"runs": [truth.get(r["run"]) for r in reduced["runs"]],
+                                          "steady_turn": {k: v for k, v in res.calm_water.items()
+                                                          if k.startswith("spiral_run_")},
+                                          "imo": imo_truth},
+            "error": {"summary": summary, "runs": runs}}
+
+
+def json_ready(x):
+    if isinstance(x, dict):
+        return {k: json_ready(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_ready(v) for v in x]
+    if hasattr(x, "to_dict"):
+        return json_ready(x.to_dict())
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
 def score_trial(kind: str, reduced: dict, res, name: str) -> dict:
     if kind == "standardization":
         return score_standardization(reduced, res, name)
     if kind == "log_calibration":
         return score_log_calibration(reduced, res, name)
+    if kind == "maneuvering":
+        return score_maneuvering(reduced, res, name)
     raise ValueError(f"no scoring for trial kind {kind!r}")

@@ -102,6 +102,7 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     timings["instruments_s"] = crew.instrument_wall_s
     t1 = time.perf_counter()
     calm = calm_water_truth(scn, crew)
+    calm.update(spiral_truth(scn, crew))
     timings["calm_water_s"] = time.perf_counter() - t1
     return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings)
 
@@ -144,6 +145,29 @@ def calm_water_truth(scn: Scenario, crew: Crew) -> dict:
         for s, p in zip(settings + extra, pts):
             p.update({"group": s["group"], "modes": s["modes"], "rps_order": s["rps"], "pitch_order": s["pitch"]})
         out[trial.head.name] = pts
+    return out
+
+
+def spiral_truth(scn: Scenario, crew: Crew) -> dict:
+    """For every spiral run: the steady-turning curve δ(r) of the model's own equations at the run's
+    shaft settings (calm deep water) and its hysteresis loop (:mod:`vtrials.steadyturn`)."""
+    from .steadyturn import hysteresis, steady_turning_curve
+    out = {}
+    cache = {}
+    for a in crew.attempts:
+        if not a.accepted or a.run.kind not in ("direct_spiral", "reverse_spiral"):
+            continue
+        rps = tuple(r * RPM for r in a.rpm_ordered)
+        pitch = tuple(p for p in a.pitch_ordered) if a.pitch_ordered and a.pitch_ordered[0] is not None else ()
+        key = (rps, pitch)
+        if key not in cache:
+            curve = steady_turning_curve(scn.vessel, rps, pitch, dt=scn.head.timestep_s)
+            loop = hysteresis(curve)
+            cache[key] = {"curve": {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
+                                    for k, v in curve.items()},
+                          "hysteresis": {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
+                                         for k, v in loop.items()}}
+        out[f"spiral_run_{a.run.number}"] = cache[key]
     return out
 
 

@@ -89,7 +89,9 @@ def turning(t, x_w, y_w, heading, u_r, v_r, r, *, steady_from_deg: float = 360.0
             _, _, R = fit_circle(x_w[m], y_w[m])
             out["steady_turning_diameter_m"] = 2.0 * R
             out["steady_speed_mps"] = float(np.mean(np.hypot(u_r[m], v_r[m])))
-            out["steady_rate_of_turn_dps"] = float(np.degrees(np.mean(np.abs(r[m]))))
+            # rate of turn: the rate of change of heading (a heeled ship's body yaw rate is smaller by
+            # cos φ cos θ)
+            out["steady_rate_of_turn_dps"] = float(np.degrees(abs(np.polyfit(t[m], heading[m], 1)[0])))
             out["steady_drift_angle_deg"] = float(np.degrees(np.mean(np.arctan2(-v_r[m], u_r[m]))))
     return out
 
@@ -107,14 +109,16 @@ def _peak(t: np.ndarray, f: np.ndarray, i0: int, i1: int) -> tuple[float, float]
     return float(f[k]), float(t[k])
 
 
-def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int) -> dict:
+def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int,
+           base: float | None = None) -> dict:
     """Zig-zag (δ/ψ) metrics from EXECUTE (index 0): first and second overshoot angles and times,
     initial turning time (EXECUTE to the first heading threshold, i.e. the second execute), time
-    to check yaw, and the period (first to third threshold crossing)."""
+    to check yaw, and the period (first to third threshold crossing). Heading changes are counted
+    from ``base`` [rad] (the ordered course; default the heading at EXECUTE)."""
     t = np.asarray(t, float)
     s = 1.0 if first_side > 0 else -1.0
     a = math.radians(heading_deg)
-    f = s * (heading - heading[0])
+    f = s * (heading - (heading[0] if base is None else base))
     out: dict = {"rudder_deg": rudder_deg, "heading_deg": heading_deg}
     c1 = _first_crossing(t, f, a)
     if c1 is None:

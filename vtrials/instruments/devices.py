@@ -455,6 +455,15 @@ class Heading(Device):
     def outputs(self, t, y):
         return {"heading": _wrap2pi(y)}
 
+    def meta(self):
+        m = super().meta()
+        # the maker's drift specification (what the team knows): the slow wander's standard deviation
+        # and correlation time, and the resolution
+        gm = self.spec.get("gauss_markov", {"sd": 0.0, "tau_s": 1.0})
+        m.update({"drift_std_rad": float(gm["sd"]) * self.f, "drift_tau_s": float(gm["tau_s"]),
+                  "resolution_rad": float(self.spec.get("resolution", 0.0)) * self.f})
+        return m
+
 
 class Attitude(Device):
     """Vertical gyro: roll and pitch."""
@@ -738,6 +747,8 @@ class RudderAngle(Device):
     def meta(self):
         m = super().meta()
         m["rudder_index"] = self.index
+        # the synchro's stated accuracy (calibration certificate), as a standard uncertainty
+        m["calibration_uncertainty_rad"] = _dist(self.spec, "bias", self.f)[1]
         return m
 
 

@@ -34,7 +34,7 @@ from vtrials.reduce import turning as TU
 from vtrials.reduce import zigzag as ZZ
 from vtrials.reduce.estimate import Estimate
 
-TRACKING = ("range_radar", "gnss", "acoustic_range")
+TRACKING = ("gnss", "range_radar", "acoustic_range")
 
 
 def _kinds(rec: Record) -> dict:
@@ -58,11 +58,29 @@ class Channels:
         self.t, self.north, self.east = t[ok], n[ok], e[ok]
         g = k.get("heading", [None])[0]
         self.t_heading, self.heading = rec.channel(g, "heading") if g else (None, None)
+        gm = rec.meta(g) if g else {}
+        self.gyro_drift = (float(gm.get("drift_std_rad", 0.0)), float(gm.get("drift_tau_s", 1.0)))
+        self.gyro_resolution = float(gm.get("resolution_rad", 0.0))
         if self.heading is not None:
             self.heading = np.unwrap(self.heading)
         a = k.get("attitude", [None])[0]
         self.t_roll, self.roll = rec.channel(a, "roll") if a else (None, None)
+        self.t_pitch, self.pitch = rec.channel(a, "pitch") if a else (None, None)
+        # the fixes are of the antenna: move them to the ship's reference point (midship, waterline)
+        # with its surveyed position and the gyro / vertical-gyro attitude (IMO definitions refer to
+        # the ship, and a 10-m lever arm is 10 % of a patrol vessel's transfer)
+        self.lever_arm = np.asarray(rec.meta(self.tracking).get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
+        if self.heading is not None and np.any(self.lever_arm != 0.0):
+            psi = np.interp(self.t, self.t_heading, self.heading)
+            phi = np.interp(self.t, self.t_roll, self.roll) if self.roll is not None else 0.0 * psi
+            th = np.interp(self.t, self.t_pitch, self.pitch) if self.pitch is not None else 0.0 * psi
+            dn, de = _horizontal_offset(self.lever_arm, phi, th, psi)
+            self.north = self.north - dn
+            self.east = self.east - de
         rud = k.get("rudder", [])
+        # the synchros' calibration uncertainty, common to every reading (of the mean of n synchros)
+        cal = [float(rec.meta(r).get("calibration_uncertainty_rad", 0.0)) for r in rud]
+        self.rudder_cal = math.sqrt(sum(c * c for c in cal)) / max(len(cal), 1)
         if rud:
             self.t_rudder, r0 = rec.channel(rud[0], "angle")
             vals = [r0] + [np.interp(self.t_rudder, *rec.channel(r, "angle")) for r in rud[1:]]
@@ -84,12 +102,130 @@ class Channels:
         return out
 
 
+def _horizontal_offset(s, phi, theta, psi):
+    """North and east components of a body-frame offset s = (x fwd, y stbd, z down) [m] after the z-y-x
+    Euler rotation (roll φ, pitch θ, heading ψ) [rad]."""
+    cf, sf, ct, st, cp, sp = np.cos(phi), np.sin(phi), np.cos(theta), np.sin(theta), np.cos(psi), np.sin(psi)
+    x, y, z = s
+    n = cp * ct * x + (cp * st * sf - sp * cf) * y + (cp * st * cf + sp * sf) * z
+    e = sp * ct * x + (sp * st * sf + cp * cf) * y + (sp * st * cf - cp * sf) * z
+    return n, e
+
+
+class DriftLine:
+    """Drift (north, east) [m/s] against time of day: a least-squares line through the circles' drifts
+    (a constant below four circles), with the standard error of the line and the scatter τ about it."""
+
+    def __init__(self, times, drifts):
+        t = np.asarray(times, float)
+        v = np.array([[d.north.value, d.east.value] for d in drifts])
+        self.tm = float(t.mean())
+        n = t.size
+        line = n >= 4 and np.ptp(t) > 0
+        A = np.column_stack([np.ones(n), t - self.tm]) if line else np.ones((n, 1))
+        coef, *_ = np.linalg.lstsq(A, v, rcond=None)
+        res = v - A @ coef
+        dof = n - A.shape[1]
+        own = np.array([[d.north.std, d.east.std] for d in drifts])
+        if dof > 0:
+            s2 = np.sum(res ** 2, axis=0) / dof
+        else:
+            s2 = np.mean(own ** 2, axis=0)
+        self.coef, self.A_inv = coef, np.linalg.pinv(A.T @ A)
+        self.s2 = s2
+        # scatter beyond the circles' own noise: the wind's push and anything else a line misses
+        self.tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - np.mean(own ** 2, axis=0), 0.0)))
+        self.line = line
+        self.dof = max(dof, 1)
+
+    def __call__(self, t: float) -> tuple[Estimate, Estimate]:
+        a = np.array([1.0, t - self.tm]) if self.line else np.array([1.0])
+        val = a @ self.coef
+        out = []
+        for ax in range(2):
+            # τ² twice: the side-dependent part of the wind's push shows as scatter about the line; the
+            # part common to both sides (a downwind drift the line cannot tell from current) is taken
+            # to be of the same size
+            var = float(a @ self.A_inv @ a) * self.s2[ax] + 2.0 * self.tau[ax] ** 2
+            out.append(Estimate(float(val[ax]), math.sqrt(var), self.dof))
+        return out[0], out[1]
+
+
+def drift_model(times, drifts) -> DriftLine | None:
+    return DriftLine(times, drifts) if len(drifts) >= 2 else None
+
+
+def periodic_steady_window(t_heading, heading, t_execute: float, *, tol: float = 0.02,
+                           min_span_deg: float = 400.0) -> TU.SteadyWindow | None:
+    """Steady part of a turn in wind: the turn is steady once the time to turn a full 360° no longer
+    changes (within ``tol``). In wind the rate of turn varies with heading around every circle, so a
+    constant-rate test never passes; the time per revolution averages that out — and 360° pairs are
+    what the drift correction uses anyway. Returns None when the record is too short (< 400° after
+    EXECUTE), so the caller falls back to the rate-window test."""
+    th = np.asarray(t_heading, float)
+    psi = np.unwrap(np.asarray(heading, float))
+    m = th >= t_execute
+    th, psi = th[m], psi[m]
+    if th.size < 20:
+        return None
+    sgn = 1.0 if psi[-1] >= psi[0] else -1.0
+    d = np.maximum.accumulate(sgn * (psi - psi[0]))
+    full = 2 * math.pi
+    if d[-1] < math.radians(min_span_deg):
+        return None
+    idx = np.flatnonzero(d + full <= d[-1])
+    T = np.interp(d[idx] + full, d, th) - th[idx]
+    tail = T[int(0.75 * T.size):]
+    T_ref = float(np.median(tail))
+    bad = np.flatnonzero(np.abs(T - T_ref) > tol * T_ref)
+    k0 = int(bad[-1]) + 1 if bad.size else 0
+    if k0 >= idx.size - 2:
+        return TU.SteadyWindow(float(th[-1]), float(th[-1]), Estimate(sgn * full / T_ref, math.inf), False, 0.0,
+                               f"time per revolution not steady within {100 * tol:.0f} %")
+    i0 = int(idx[k0])
+    Ts = T[k0:]
+    # revolutions overlapping by less than a full turn are not independent: n_eff ≈ span after t0 / 360°
+    n_eff = max((d[-1] - d[i0]) / full - 1.0, 1.0)
+    rate = sgn * full / float(np.mean(Ts))
+    rate_se = abs(rate) * float(np.std(Ts, ddof=1) if Ts.size > 1 else 0.0) / float(np.mean(Ts)) / math.sqrt(n_eff)
+    span = float(d[-1] - d[i0])
+    return TU.SteadyWindow(float(th[i0]), float(th[-1]), Estimate(rate, rate_se), True, span,
+                           "steady: constant time per revolution (wind-robust)")
+
+
 def _rate(t, psi) -> Estimate:
     tc = t - t.mean()
     s = float(tc @ (psi - psi.mean()) / (tc @ tc))
     res = psi - psi.mean() - s * tc
     se = math.sqrt(float(res @ res) / max(t.size - 2, 1) / float(tc @ tc))
     return Estimate(s, se, max(t.size - 2, 1))
+
+
+def _add_gyro_drift(d: dict, lead_s: float, drift: tuple[float, float]) -> None:
+    """An overshoot angle is a heading difference between the approach and the peak: the gyro's slow
+    wander (Gauss–Markov, σ and τ from the maker's specification) between the two adds
+    σ_Δ² = 2σ²(1 − exp(−Δt/τ)) to its variance."""
+    sd, tau = drift
+    if sd <= 0:
+        return
+    for key in ("first_overshoot", "second_overshoot"):
+        e = d.get(key)
+        tk = d.get(f"{key}_time")  # after the first rudder execute
+        if not isinstance(e, dict) or tk is None:
+            continue
+        dt = abs(tk["value"] if isinstance(tk, dict) else tk) + lead_s
+        extra = 2.0 * sd * sd * (1.0 - math.exp(-dt / tau))
+        d[key] = Estimate(e["value"], math.sqrt(e["std"] ** 2 + extra), e.get("dof")).to_dict()
+
+
+def _add_rudder_calibration(points: list, cal: float) -> None:
+    """Widen each point's rudder uncertainty by the synchros' calibration (it shifts the whole curve,
+    not the loop's width)."""
+    for q in points:
+        ru = q.get("rudder")
+        if isinstance(ru, dict) and ru.get("std") is not None:
+            e = Estimate(ru["value"], math.hypot(ru["std"], cal), ru.get("dof"))
+            q["rudder"] = e.to_dict()
 
 
 def _clean(d):
@@ -123,9 +259,11 @@ def reduce_maneuvering(rec: Record) -> dict:
         w = ch.window(r["t_comex"] - 5.0, r["t_finex"])
         approach = r["t_execute"] - r["t_comex"]
         try:
+            sw = periodic_steady_window(w["t_heading"], w["heading"], r["t_execute"])
             res = TU.turning_metrics(w["t"], w["north"], w["east"], w["heading"], r["t_execute"],
                                      t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
-                                     rudder=w.get("rudder"), t_rudder=w.get("t_rudder"), approach_s=approach)
+                                     rudder=w.get("rudder"), t_rudder=w.get("t_rudder"), approach_s=approach,
+                                     steady=sw)
         except (ValueError, np.linalg.LinAlgError) as exc:
             out_runs.append({"run": r["run"], "type": "turn", "error": str(exc)})
             continue
@@ -136,6 +274,30 @@ def reduce_maneuvering(rec: Record) -> dict:
         if res.drift is not None:
             drift_times.append(0.5 * (r["t_execute"] + r["t_finex"]))
             drifts.append(res.drift)
+    # The day's drift model: a straight line in time through the circles' own drifts (constant with
+    # fewer than four circles). Each circle's drift also holds the wind's push on the turning ship,
+    # which differs between starboard and port turns; a line through circles of both sides averages
+    # that part out, and the scatter about the line (τ) is kept as a drift uncertainty.
+    model = drift_model(drift_times, drifts)
+    if model is not None and len(turns) >= 2:
+        for k, d in enumerate(out_runs):
+            r, res0 = next((x for x in turns if x[0]["run"] == d["run"]), (None, None))
+            if r is None:
+                continue
+            tm = 0.5 * (r["t_execute"] + r["t_finex"])
+            dn, de = model(tm)
+            w = ch.window(r["t_comex"] - 5.0, r["t_finex"])
+            try:
+                res = TU.turning_metrics(w["t"], w["north"], w["east"], w["heading"], r["t_execute"],
+                                         t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
+                                         rudder=w.get("rudder"), t_rudder=w.get("t_rudder"),
+                                         approach_s=r["t_execute"] - r["t_comex"], steady=res0.steady, drift=(dn, de))
+            except (ValueError, np.linalg.LinAlgError):
+                continue
+            own = d.get("drift")
+            d.update(_clean(res.to_dict()))
+            d["drift_own_circle"] = own
+            d["drift_method"] = "day's drift line through all circles (both sides)"
     for r in runs:
         kind = r["maneuver"].get("type")
         p = r["maneuver"]
@@ -147,20 +309,29 @@ def reduce_maneuvering(rec: Record) -> dict:
                    "t_finex": r["t_finex"], "completed": r.get("completed", True)}
         try:
             if kind == "speed_change":
-                drift = RE.interpolate_drift(drift_times, drifts, 0.5 * (r["t_execute"] + r["t_finex"])) \
-                    if drifts else None
+                drift = None
+                if model is not None:
+                    dn, de = model(0.5 * (r["t_execute"] + r["t_finex"]))
+                    drift = RE.InterpolatedDrift(dn, de, False, model.tau)
                 res = RE.reach_analysis(w["t"], w["north"], w["east"], r["t_execute"], heading=w["heading"],
                                         t_heading=w["t_heading"], drift=drift, approach_s=approach,
                                         seed=int(r["run"]))
                 d.update(_clean(res.to_dict()))
+                cv = res.curve
+                if cv:
+                    step = max(1, len(cv["t"]) // 300)
+                    d["curve"] = {k: np.asarray(cv[k])[::step].tolist() for k in ("t", "reach", "lateral", "speed")
+                                  if k in cv}
                 d["drift_used"] = None if drift is None else {"north": drift.north.to_dict(),
                                                               "east": drift.east.to_dict(),
                                                               "extrapolated": drift.extrapolated}
                 d["to_order"] = p.get("to_order")
             elif kind == "zigzag":
                 res = ZZ.zigzag_metrics(w["t_heading"], w["heading"], w["t_rudder"], w["rudder"],
-                                        check_angle=p["check"], approach_s=approach)
+                                        check_angle=p["check"], approach_s=approach,
+                                        heading_resolution=ch.gyro_resolution)
                 d.update(_clean(res.to_dict()))
+                _add_gyro_drift(d, 0.5 * approach, ch.gyro_drift)
                 d["rudder_ordered"] = p["rudder"]
                 sp = ch.window(r["t_comex"], r["t_execute"])
                 if sp["t"].size >= 3:
@@ -168,14 +339,19 @@ def reduce_maneuvering(rec: Record) -> dict:
                     d["approach_sog"] = math.hypot(vn, ve)
             elif kind == "direct_spiral":
                 wr = ch.window(r["t_execute"], r["t_finex"])
-                res = SPI.direct_spiral(wr["t_heading"], wr["heading"], wr["t_rudder"], wr["rudder"])
+                # the director's setting marks are in the log: each hold runs from its mark to the next
+                holds = [(st["t_set"], st["t_end"]) for st in r.get("settings", [])]
+                res = SPI.direct_spiral(wr["t_heading"], wr["heading"], wr["t_rudder"], wr["rudder"],
+                                        holds=holds or None)
                 d.update(_clean(res.to_dict()))
+                _add_rudder_calibration(d.get("points", []), ch.rudder_cal)
                 d["settings_logged"] = r.get("settings", [])
             elif kind == "reverse_spiral":
                 segs = [(s["t_end"] - p["hold_s"], s["t_end"]) for s in r.get("settings", []) if s["steady"]]
                 pts = SPI.reverse_spiral_points(w["t_heading"], w["heading"], w["t_rudder"], w["rudder"], segs)
                 d["points"] = [{"rate": _clean(q.rate), "rudder": _clean(q.rudder), "window": list(q.window)}
                                for q in pts]
+                _add_rudder_calibration(d["points"], ch.rudder_cal)
                 try:
                     d["loop"] = _clean(SPI.hysteresis_loop(pts).to_dict())
                 except (ValueError, np.linalg.LinAlgError) as exc:
@@ -210,7 +386,9 @@ def reduce_maneuvering(rec: Record) -> dict:
                                      "rate_std": g.rate_std, "breakdown": g.breakdown,
                                      "breakdown_rudder": g.breakdown_rudder}))
     return {"kind": "maneuvering", "tracking": ch.tracking, "runs": out_runs, "rate_vs_rudder": breakdown,
-            "drift_circles": {"times": drift_times, "drifts": [_clean(x) for x in drifts]},
+            "drift_circles": {"times": drift_times, "drifts": [_clean(x) for x in drifts],
+                              "line": None if model is None else {"coef": model.coef.tolist(), "t_ref": model.tm,
+                                                                  "tau": list(model.tau), "linear": model.line}},
             "imo": imo_verdicts(out_runs, runs, L)}
 
 

@@ -485,4 +485,7 @@ def reduce_record(rec: Record) -> dict:
         return reduce_standardization(rec)
     if kind == "log_calibration":
         return reduce_log_calibration(rec)
+    if kind == "maneuvering":
+        from vtrials.reduce.maneuvering import reduce_maneuvering
+        return reduce_maneuvering(rec)
     raise ValueError(f"{rec.path}: no reduction for trial kind {kind!r}")
