@@ -42,7 +42,7 @@ kind = "maneuvering"
 
 @pytest.mark.parametrize("run_text, field, words", [
     ('type = "turn"\norder = "standard"', "agenda.trial[0].run[0].rudder_deg", "needs rudder_deg"),
-    ('type = "turn"\norder = "standard"\nrudder_deg = 50.0', "agenda.trial[0].run[0].rudder_deg", "between"),
+    ('type = "turn"\norder = "standard"\nrudder_deg = 50.0', "agenda.trial[0].run[0].rudder_deg", "out of range"),
     ('type = "turn"\norder = "standard"\nrudder_deg = 40.0', "agenda.trial[0].run[0].rudder_deg",
      "beyond the maximum rudder"),
     ('type = "speed_change"\norder = "full"', "agenda.trial[0].run[0].to_order", "to_order or to_rpm"),
@@ -108,7 +108,9 @@ def test_periodic_steady_window_in_wind():
     # the revolution-averaged rate is exact once the transient has died out
     T = np.interp(psi[-1], psi, t) - np.interp(psi[-1] - 2 * math.pi, psi, t)
     assert sw.rate.value == pytest.approx(2 * math.pi / T, rel=2e-3)
-    assert sw.t_start > 100.0  # the transient (time constant 40 s) is left out
+    # the start of the transient is left out: a revolution from t_start on turns within 2 % of the
+    # steady time per revolution (the ramp reaches 90 % at 92 s)
+    assert 60.0 < sw.t_start < 200.0
 
 
 def test_drift_line_averages_the_side_dependent_push():
@@ -231,14 +233,30 @@ def test_kvlcc2_spiral_loop_matches_the_steady_turn_solutions(spirals):
         assert abs(math.degrees(w["value"] - lp["true_width"])) < 0.5, (kind, lp)
 
 
-def test_unsettled_spiral_settings_are_reported(spirals):
-    """Settings near the loop's folds settle slowly; whatever did not settle in time is in the log and
-    never averaged into a point."""
-    tr = spirals["kvlcc2_spiral"]["trials"][0]
-    log = [r for r in spirals["kvlcc2_spiral"]["agenda"]["runs"] if r["maneuver"]["type"] == "direct_spiral"][0]
-    unsettled = [s for s in log["settings"] if not s["steady"]]
-    notes = " ".join(log["run_notes"])
-    for s in unsettled:
-        assert f"setting {s['index'] + 1}" in notes
-    red = next(r for r in tr["reduced"]["runs"] if r["type"] == "direct_spiral")
-    assert all(p["steady"] for p in red["points"] if p.get("branch") in ("down", "up"))
+UNSETTLED = HEAD.replace('[[agenda.trial.run]]', """[[agenda.trial.run]]
+type = "direct_spiral"
+order = "ahead_2_3"
+sequence_deg = [10.0, 4.0, -4.0, -10.0]
+hold_s = 60.0
+max_setting_s = 150.0
+""")
+
+
+def test_unsettled_spiral_settings_are_reported(tmp_path):
+    """A setting that does not settle within the agenda's time limit is logged as such, flagged in the
+    reduction and left out of the loop — never averaged as if steady."""
+    res = run(_write(tmp_path, UNSETTLED), tmp_path / "out", plot=False)
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    log = doc["agenda"]["runs"][0]
+    assert log["settings"] and not any(s["steady"] for s in log["settings"])
+    assert all(f"setting {s['index'] + 1}" in " ".join(log["run_notes"]) for s in log["settings"])
+    assert log["completed"] is False and res.attempts[0].completed is False
+    red = doc["trials"][0]["reduced"]["runs"][0]
+    assert red["points"] and not any(p["steady"] for p in red["points"])
+    assert red["loop"]["verdict"] != "unstable (loop)"
+
+
+def _write(tmp_path, text):
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    return p

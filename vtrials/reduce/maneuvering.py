@@ -22,6 +22,7 @@ IMO MSC.137(76) verdicts from whichever of the standard maneuvers the trial cont
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -183,7 +184,7 @@ def periodic_steady_window(t_heading, heading, t_execute: float, *, tol: float =
         return TU.SteadyWindow(float(th[-1]), float(th[-1]), Estimate(sgn * full / T_ref, math.inf), False, 0.0,
                                f"time per revolution not steady within {100 * tol:.0f} %")
     i0 = int(idx[k0])
-    Ts = T[k0:]
+    Ts = T[k0 + (idx.size - k0) // 2:]  # the later half: the tail of the transient left out of the rate
     # revolutions overlapping by less than a full turn are not independent: n_eff ≈ span after t0 / 360°
     n_eff = max((d[-1] - d[i0]) / full - 1.0, 1.0)
     rate = sgn * full / float(np.mean(Ts))
@@ -216,6 +217,36 @@ def _add_gyro_drift(d: dict, lead_s: float, drift: tuple[float, float]) -> None:
         dt = abs(tk["value"] if isinstance(tk, dict) else tk) + lead_s
         extra = 2.0 * sd * sd * (1.0 - math.exp(-dt / tau))
         d[key] = Estimate(e["value"], math.sqrt(e["std"] ** 2 + extra), e.get("dof")).to_dict()
+
+
+def _model_free_width(loop: dict, lr) -> None:
+    """When the cubic S-curve does not describe the points (χ²/dof > 3 — an asymmetric or kinked δ(r)
+    such as KVLCC2's), its width and uncertainty mean little; the direct spiral's own bracket (the
+    loop's edges lie between the last setting before each jump and the first after it) is then the
+    estimate: the middle of the bracket, with a uniform distribution across it."""
+    curve = getattr(lr, "curve", None)
+    br = (lr.direct or {}).get("width_bracket")
+    if curve is None or curve.chi2_per_dof <= 3 or not br or not str(lr.verdict).startswith("unstable"):
+        return
+    lo, hi = float(br[0]), float(br[1])
+    loop["width_cubic"] = loop.get("width")
+    loop["width"] = Estimate(0.5 * (lo + hi), (hi - lo) / math.sqrt(12.0)).to_dict()
+    loop["width_method"] = "bracket between settings (cubic S-curve rejected)"
+
+
+def _add_gyro_rate_drift(points: list, drift: tuple[float, float]) -> None:
+    """A rate of turn over a window W also carries the gyro's slow wander across the window:
+    σ_r ≈ σ √(2(1 − exp(−W/τ)))/W (σ, τ the maker's drift specification)."""
+    sd, tau = drift
+    if sd <= 0:
+        return
+    for q in points:
+        ra, win = q.get("rate"), q.get("window") or q.get("hold")
+        if not isinstance(ra, dict) or ra.get("std") is None or not win:
+            continue
+        W = max(float(win[1]) - float(win[0]), 1.0)
+        extra = sd * math.sqrt(2.0 * (1.0 - math.exp(-W / tau))) / W
+        q["rate"] = Estimate(ra["value"], math.hypot(ra["std"], extra), ra.get("dof")).to_dict()
 
 
 def _add_rudder_calibration(points: list, cal: float) -> None:
@@ -342,9 +373,23 @@ def reduce_maneuvering(rec: Record) -> dict:
                 # the director's setting marks are in the log: each hold runs from its mark to the next
                 holds = [(st["t_set"], st["t_end"]) for st in r.get("settings", [])]
                 res = SPI.direct_spiral(wr["t_heading"], wr["heading"], wr["t_rudder"], wr["rudder"],
-                                        holds=holds or None)
+                                        holds=holds or None, window_s=p.get("hold_s") or 120.0)
+                # a setting the director logged as never steady is not a steady point, whatever its
+                # last window looks like: flagged and left out of the loop
+                logged = r.get("settings", [])
+                if holds and len(res.points) == len(logged) and \
+                        any(q.steady and not st["steady"] for q, st in zip(res.points, logged)):
+                    pts = [dataclasses.replace(q, steady=False, note=(q.note + "; " if q.note else "")
+                                               + "logged not steady within the time allowed")
+                           if q.steady and not st["steady"] else q for q, st in zip(res.points, logged)]
+                    res = SPI.SpiralResult(pts, SPI.hysteresis_loop(pts),
+                                           [q for q in pts if q.steady and q.branch == "down"],
+                                           [q for q in pts if q.steady and q.branch == "up"],
+                                           [q for q in pts if not q.steady])
                 d.update(_clean(res.to_dict()))
                 _add_rudder_calibration(d.get("points", []), ch.rudder_cal)
+                _add_gyro_rate_drift(d.get("points", []), ch.gyro_drift)
+                _model_free_width(d.get("loop") or {}, res.loop)
                 d["settings_logged"] = r.get("settings", [])
             elif kind == "reverse_spiral":
                 segs = [(s["t_end"] - p["hold_s"], s["t_end"]) for s in r.get("settings", []) if s["steady"]]
@@ -352,6 +397,7 @@ def reduce_maneuvering(rec: Record) -> dict:
                 d["points"] = [{"rate": _clean(q.rate), "rudder": _clean(q.rudder), "window": list(q.window)}
                                for q in pts]
                 _add_rudder_calibration(d["points"], ch.rudder_cal)
+                _add_gyro_rate_drift(d["points"], ch.gyro_drift)
                 try:
                     d["loop"] = _clean(SPI.hysteresis_loop(pts).to_dict())
                 except (ValueError, np.linalg.LinAlgError) as exc:
