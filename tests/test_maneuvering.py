@@ -260,3 +260,93 @@ def _write(tmp_path, text):
     p = tmp_path / "s.toml"
     p.write_text(text)
     return p
+
+
+MIXED = """
+[scenario]
+title = "mixed maneuvers"
+ship = "patrol51"
+seed = 11
+timestep_s = 0.05
+truth_every = 20
+
+[environment]
+water_depth_m = 100.0
+
+[environment.wind]
+speed_kn = 12.0
+direction_deg = 250.0
+
+[agenda]
+base_course_deg = 0.0
+approach_s = 30.0
+settle_min_s = 30.0
+
+[agenda.steadiness]
+window_s = 30.0
+
+[[agenda.trial]]
+name = "mixed"
+kind = "maneuvering"
+
+[[agenda.trial.run]]
+type = "zigzag"
+order = "standard"
+rudder_deg = -20.0
+course = "into_wind"
+
+[[agenda.trial.run]]
+type = "pull_out"
+order = "standard"
+rudder_deg = 20.0
+heading_change_deg = 200.0
+hold_s = 120.0
+
+[[agenda.trial.run]]
+type = "speed_change"
+order = "full"
+to_order = "stop"
+rudder_mode = "hard_over"
+rudder_deg = 35.0
+max_duration_s = 600.0
+
+[[agenda.trial.run]]
+type = "speed_change"
+order = "ahead_2_3"
+to_order = "full"
+rudder_mode = "cycle"
+rudder_deg = 10.0
+cycle_s = 20.0
+max_duration_s = 600.0
+
+[[agenda.trial.run]]
+type = "backing"
+order = "back_2_3"
+rudder_deg = 35.0
+hold_s = 120.0
+"""
+
+
+def test_every_maneuver_kind_runs_and_reduces(tmp_path):
+    res = run(_write(tmp_path, MIXED), tmp_path / "out", plot=True)
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    log = doc["agenda"]["runs"]
+    assert [r["maneuver"]["type"] for r in log] == ["zigzag", "pull_out", "speed_change", "speed_change", "backing"]
+    # the zig-zag was run into the wind: the course the crew chose is within 15° of where the wind comes from
+    assert abs(((log[0]["course_deg"] - 250.0 + 180.0) % 360.0) - 180.0) < 15.0
+    # the pull-out released the rudder and the patrol vessel (stable) stops turning
+    red = {r["run"]: r for r in doc["trials"][0]["reduced"]["runs"]}
+    po = red[2]
+    assert abs(po["rate_before_release"]["value"]) > math.radians(1.0)
+    assert abs(po["residual_rate"]["value"]) < 0.1 * abs(po["rate_before_release"]["value"])
+    # stop with the rudder hard over: the ship turns; the cycled-rudder acceleration reaches Full speed
+    tr = {r["run"]: r for r in doc["trials"][0]["truth"]["runs"]}
+    cols = res.crew.columns(np.concatenate(res.crew.truth_rows))
+    a3 = res.attempts[2]
+    psi = np.interp([a3.t_execute, a3.t_finex], cols["t"], cols["heading"])
+    assert abs(math.degrees(psi[1] - psi[0])) > 30.0  # held on a course it would have kept within 3°
+    assert red[4]["terminal_speed"]["value"] == pytest.approx(tr[4]["terminal_speed_mps"], rel=0.02)
+    # backing: the astern approach (EM log shows nothing astern), then the rudder is tried
+    assert tr[5]["astern_speed_mps"] < -0.5 and red[5]["approach_sog"] > 0.5
+    assert all(r["completed"] for r in log)
+    assert res.attempts[-1].run.order == "back_2_3"

@@ -579,6 +579,9 @@ class Crew:
             self.back_to_range(run)
             if p.get("course_rule") in ("into_wind", "with_wind"):
                 w = self.true_wind_from()
+                if w is None:  # nothing on the anemometer display yet: steam a minute and look again
+                    self.advance(MAX_SLICE_S)
+                    w = self.true_wind_from()
                 if w is not None:
                     course = w if p["course_rule"] == "into_wind" else w + math.pi
                     course = math.atan2(math.sin(course), math.cos(course))
