@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .crew import _clock
 from .records import atomic_path
 from .units import KNOT
 
@@ -37,11 +38,6 @@ def _fmt(x, nd=2):
     if x is None or isinstance(x, str) or (isinstance(x, float) and not math.isfinite(x)):
         return "–" if x is None or not isinstance(x, str) else x
     return f"{x:.{nd}f}"
-
-
-def _clock(t: float) -> str:
-    s = int(round(t))
-    return f"{s // 3600:02d}:{s % 3600 // 60:02d}:{s % 60:02d}"
 
 
 # ----------------------------------------------------------------------------------- standardization
@@ -339,6 +335,11 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
                             fmt="o" if ok else "x", color="C0" if ok else "C3", ms=4)
             ax.axhline(0, color="0.7", lw=0.5)
             ax.axvline(0, color="0.7", lw=0.5)
+            dd = [math.degrees(q["rudder"]["value"]) for q in r["points"]]
+            rr = [math.degrees(q["rate"]["value"]) for q in r["points"]]
+            pad = 0.15 * (max(dd) - min(dd)) + 0.2
+            ax.set_xlim(min(dd) - pad, max(dd) + pad)  # the data's range: a narrow loop stays visible
+            ax.set_ylim(min(rr) - 0.1 * abs(min(rr)) - 0.01, max(rr) + 0.1 * abs(max(rr)) + 0.01)
             ax.set_xlabel("rudder [deg]")
             ax.set_ylabel("rate of turn [deg/s]")
             ax.set_title(f"{r['label']} (x: never steady)", fontsize=8)
