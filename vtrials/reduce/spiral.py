@@ -57,37 +57,11 @@ from typing import Sequence
 import numpy as np
 
 from vtrials.reduce.estimate import Estimate
+from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation
 from vtrials.units import DEG
 
 
 # --------------------------------------------------------------------------------------------- helpers
-def _clean(t, *ys):
-    t = np.asarray(t, float).ravel()
-    arrs = [np.asarray(y, float).ravel() for y in ys]
-    ok = np.isfinite(t)
-    for a in arrs:
-        if a.shape != t.shape:
-            raise ValueError("channel and time arrays differ in length")
-        ok &= np.isfinite(a)
-    order = np.argsort(t[ok], kind="stable")
-    t = t[ok][order]
-    arrs = [a[ok][order] for a in arrs]
-    keep = np.concatenate([[True], np.diff(t) > 0])
-    return (t[keep], *[a[keep] for a in arrs])
-
-
-def _ar1_inflation(resid) -> float:
-    r = np.asarray(resid, float)
-    if len(r) < 8:
-        return 1.0
-    r = r - r.mean()
-    den = float(r @ r)
-    if den <= 0:
-        return 1.0
-    rho = min(max(float(r[1:] @ r[:-1]) / den, 0.0), 0.95)
-    return math.sqrt((1 + rho) / (1 - rho))
-
-
 def _slope(t, y):
     """OLS slope and its lag-1-corrected SE; dof."""
     x = t - t.mean()

@@ -77,28 +77,12 @@ import numpy as np
 from scipy import optimize, stats
 
 from vtrials.reduce.estimate import Estimate
+from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation
 
 TWO_PI = 2.0 * math.pi
 
 
 # --------------------------------------------------------------------------------------------- helpers
-def _clean(t, *ys):
-    """Float arrays sorted by time with non-finite rows and duplicate stamps dropped."""
-    t = np.asarray(t, float).ravel()
-    arrs = [np.asarray(y, float).ravel() for y in ys]
-    for a in arrs:
-        if a.shape != t.shape:
-            raise ValueError("channel and time arrays differ in length")
-    ok = np.isfinite(t)
-    for a in arrs:
-        ok &= np.isfinite(a)
-    order = np.argsort(t[ok], kind="stable")
-    t = t[ok][order]
-    arrs = [a[ok][order] for a in arrs]
-    keep = np.concatenate([[True], np.diff(t) > 0])
-    return (t[keep], *[a[keep] for a in arrs])
-
-
 def noise_sigma(t, y, chunk: int = 12) -> tuple[float, int]:
     """White-noise standard deviation of a smooth channel and its degrees of freedom.
 
@@ -133,21 +117,6 @@ def noise_sigma(t, y, chunk: int = 12) -> tuple[float, int]:
     keep = var <= 10.0 * med if med > 0 else np.ones(var.shape, bool)
     s2 = float(np.sum(var[keep] * dof[keep]) / np.sum(dof[keep]))
     return math.sqrt(s2), int(np.sum(dof[keep]))
-
-
-def _ar1_inflation(resid: np.ndarray) -> float:
-    """√((1+ρ)/(1−ρ)) for a positive lag-1 autocorrelation ρ of the residuals (1 otherwise): the
-    factor by which an OLS standard error understates the truth for AR(1) errors."""
-    r = np.asarray(resid, float)
-    if len(r) < 8:
-        return 1.0
-    r = r - r.mean()
-    den = float(r @ r)
-    if den <= 0:
-        return 1.0
-    rho = float(r[1:] @ r[:-1]) / den
-    rho = min(max(rho, 0.0), 0.95)
-    return math.sqrt((1 + rho) / (1 - rho))
 
 
 def _ols_line(t, y):

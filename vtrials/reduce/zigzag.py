@@ -42,62 +42,11 @@ import math
 import numpy as np
 
 from vtrials.reduce.estimate import Estimate
+from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_inflation as _ar1_inflation
 from vtrials.units import DEG
 
 
 # --------------------------------------------------------------------------------------------- helpers
-def _clean(t, *ys):
-    t = np.asarray(t, float).ravel()
-    arrs = [np.asarray(y, float).ravel() for y in ys]
-    ok = np.isfinite(t)
-    for a in arrs:
-        if a.shape != t.shape:
-            raise ValueError("channel and time arrays differ in length")
-        ok &= np.isfinite(a)
-    order = np.argsort(t[ok], kind="stable")
-    t = t[ok][order]
-    arrs = [a[ok][order] for a in arrs]
-    keep = np.concatenate([[True], np.diff(t) > 0])
-    return (t[keep], *[a[keep] for a in arrs])
-
-
-def noise_sigma(t, y, chunk: int = 12) -> float:
-    """White-noise σ of a smooth channel: pooled residuals of cubic fits to consecutive chunks of
-    ``chunk`` samples (chunks with variance > 10× the median dropped)."""
-    t, y = _clean(t, y)
-    n = len(t)
-    if n < 6:
-        return float("nan")
-    var, dof = [], []
-    i0 = 0
-    while i0 < n - 5:
-        i1 = n if n - (i0 + chunk) < 6 else i0 + chunk
-        tt = t[i0:i1]
-        x = (tt - tt.mean()) / max(np.ptp(tt), 1e-9)
-        A = np.vander(x, 4)
-        coef, *_ = np.linalg.lstsq(A, y[i0:i1], rcond=None)
-        r = y[i0:i1] - A @ coef
-        var.append(float(r @ r) / (len(tt) - 4))
-        dof.append(len(tt) - 4)
-        i0 = i1
-    var, dof = np.array(var), np.array(dof)
-    med = np.median(var)
-    keep = var <= 10 * med if med > 0 else np.ones(var.shape, bool)
-    return math.sqrt(float(np.sum(var[keep] * dof[keep]) / np.sum(dof[keep])))
-
-
-def _ar1_inflation(resid) -> float:
-    r = np.asarray(resid, float)
-    if len(r) < 8:
-        return 1.0
-    r = r - r.mean()
-    den = float(r @ r)
-    if den <= 0:
-        return 1.0
-    rho = min(max(float(r[1:] @ r[:-1]) / den, 0.0), 0.95)
-    return math.sqrt((1 + rho) / (1 - rho))
-
-
 def _diff(a: Estimate, b: Estimate) -> Estimate:
     return Estimate(a.value - b.value, math.hypot(a.std, b.std))
 
