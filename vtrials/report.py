@@ -26,10 +26,17 @@ def _fig():
     return plt
 
 
-def _save(fig, path: Path) -> None:
-    with atomic_path(path) as tmp:
+def _save(fig, out: Path, name: str) -> str:
+    """Write a figure atomically as out/name and close it; returns the name for the report."""
+    with atomic_path(out / name) as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
     _fig().close(fig)
+    return name
+
+
+def _pct(x):
+    """A fraction as percent (None stays None)."""
+    return None if x is None else 100 * x
 
 
 def _fmt(x, nd=2):
@@ -80,8 +87,7 @@ def _std_figures(tr: dict, out: Path) -> list[str]:
     a2.legend(fontsize=8)
     a2.grid(alpha=0.3)
     f = f"{name}_speed_power.png"
-    _save(fig, out / f)
-    files.append(f)
+    files.append(_save(fig, out, f))
     # current along the base course: reduced (per run, from the elimination) vs truth, over time
     fig, ax = plt.subplots(figsize=(9, 3.4))
     runs = {r["run"]: r for r in red["runs"]}
@@ -96,8 +102,7 @@ def _std_figures(tr: dict, out: Path) -> list[str]:
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     f = f"{name}_current.png"
-    _save(fig, out / f)
-    files.append(f)
+    files.append(_save(fig, out, f))
     return files
 
 
@@ -106,8 +111,8 @@ def _std_markdown(tr: dict, figs: list[str]) -> list[str]:
     sm = err["summary"]
     L = [f"## {tr['name']} (standardization)", "",
          f"Tracking: `{red['tracking']}`. Spots: {sm['spots']}. Largest speed error {_fmt(sm['max_abs_stw_error_kn'], 3)} kn; "
-         f"95 % intervals cover the true speed in {_fmt(100 * sm['stw_coverage'] if sm['stw_coverage'] is not None else None, 0)} % "
-         f"of spots; fitted curve within {_fmt(100 * sm['max_abs_curve_error'] if sm['max_abs_curve_error'] is not None else None, 2)} % "
+         f"95 % intervals cover the true speed in {_fmt(_pct(sm['stw_coverage']), 0)} % "
+         f"of spots; fitted curve within {_fmt(_pct(sm['max_abs_curve_error']), 2)} % "
          f"of the true calm-water power at equal speed.", ""]
     L += [f"![speed-power]({figs[0]})", "", f"![current]({figs[1]})", ""]
     L += ["| spot | runs | method | V_S [kn] | ± (95 %) | true [kn] | err [kn] | covered | P_corr [kW] | P_meas [kW] | "
@@ -157,8 +162,7 @@ def _lc_figures(tr: dict, out: Path) -> list[str]:
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
         f = f"{tr['name']}_{inst}_calibration.png"
-        _save(fig, out / f)
-        files.append(f)
+        files.append(_save(fig, out, f))
     fig, ax = plt.subplots(figsize=(9, 3.4))
     t = np.array([leg["t_mid"] for leg in red["legs"]]) / 3600
     ax.plot(t, [c["truth"][0] / KNOT for c in err["current"]], "k.-", label="true current north")
@@ -170,8 +174,7 @@ def _lc_figures(tr: dict, out: Path) -> list[str]:
     ax.legend(fontsize=8, ncol=2)
     ax.grid(alpha=0.3)
     f = f"{tr['name']}_current.png"
-    _save(fig, out / f)
-    files.append(f)
+    files.append(_save(fig, out, f))
     return files
 
 
@@ -181,7 +184,7 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
     L = [f"## {tr['name']} (speed-log calibration)", "",
          f"Tracking: `{red['tracking']}`. Legs: {sm['legs']}. Largest speed-through-water error "
          f"{_fmt(sm['max_abs_stw_error_kn'], 3)} kn; 95 % intervals cover the truth on "
-         f"{_fmt(100 * sm['stw_coverage'] if sm['stw_coverage'] is not None else None, 0)} % of legs; current error ≤ "
+         f"{_fmt(_pct(sm['stw_coverage']), 0)} % of legs; current error ≤ "
          f"{_fmt(sm['max_current_error_kn'], 3)} kn.", ""]
     L += [f"![{f}]({f})" for f in figs] + [""]
     for inst, cal in red["calibrations"].items():
@@ -219,10 +222,12 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
     tt = cols["t"]
     runs = red["runs"]
     turns = [r for r in runs if r["type"] == "turn" and r.get("advance")]
-    if turns:
+    ch = None
+    if turns or any(r["type"] == "zigzag" and "error" not in r for r in runs):
         from .records import open_record
         from .reduce.maneuvering import Channels
-        ch = Channels(open_record(out / tr["record"]))
+        ch = Channels(open_record(out / tr["record"]))  # read once for the turn and zig-zag pages
+    if turns:
         n = len(turns)
         nc = min(6, n)
         nr = int(math.ceil(n / nc))
@@ -255,8 +260,7 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
         fig.suptitle(f"{name}: drift-corrected turning tracks (across / along the approach course, m); "
                      f"dot: advance & transfer, dotted: tactical diameter", fontsize=9)
         f = f"{name}_turns.png"
-        _save(fig, out / f)
-        files.append(f)
+        files.append(_save(fig, out, f))
         # rate of turn against rudder, reduced vs true
         fig, ax = plt.subplots(figsize=(6.5, 4.2))
         truth = {x["run"]: x for x in tr["truth"]["runs"] if x}
@@ -274,8 +278,7 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         f = f"{name}_rate_vs_rudder.png"
-        _save(fig, out / f)
-        files.append(f)
+        files.append(_save(fig, out, f))
     sc = [r for r in runs if r["type"] == "speed_change" and r.get("curve")]
     if sc:
         fig, axes = plt.subplots(1, len(sc), figsize=(4.2 * len(sc), 3.4), squeeze=False)
@@ -295,13 +298,9 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
             ax.grid(alpha=0.3)
         axes[0, 0].legend(fontsize=7)
         f = f"{name}_reach.png"
-        _save(fig, out / f)
-        files.append(f)
+        files.append(_save(fig, out, f))
     zz = [r for r in runs if r["type"] == "zigzag" and "error" not in r]
     if zz:
-        from .records import open_record
-        from .reduce.maneuvering import Channels
-        ch = Channels(open_record(out / tr["record"]))
         fig, axes = plt.subplots(len(zz), 1, figsize=(9, 2.6 * len(zz)), squeeze=False)
         for ax, r in zip(axes[:, 0], zz):
             te = r["t_execute"]
@@ -318,8 +317,7 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
         axes[-1, 0].set_xlabel("time after EXECUTE [s]")
         axes[0, 0].legend(fontsize=7, ncol=3)
         f = f"{name}_zigzag.png"
-        _save(fig, out / f)
-        files.append(f)
+        files.append(_save(fig, out, f))
     sp = [r for r in runs if r["type"] in ("direct_spiral", "reverse_spiral") and r.get("points")]
     if sp:
         fig, axes = plt.subplots(1, len(sp), figsize=(5.5 * len(sp), 4.2), squeeze=False)
@@ -346,8 +344,7 @@ def _mv_figures(tr: dict, res, out: Path) -> list[str]:
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7)
         f = f"{name}_spiral.png"
-        _save(fig, out / f)
-        files.append(f)
+        files.append(_save(fig, out, f))
     return files
 
 
@@ -357,7 +354,7 @@ def _mv_markdown(tr: dict, figs: list[str]) -> list[str]:
     L = [f"## {tr['name']} (maneuvering)", "",
          f"Tracking: `{red['tracking']}`. Runs: {sm['runs']}. Advance / tactical diameter: largest error "
          f"{_fmt(100 * sm['max_rel_error_advance_tactical'], 2)} %, intervals cover "
-         f"{_fmt(100 * sm['advance_tactical_coverage'] if sm['advance_tactical_coverage'] is not None else None, 0)} %; "
+         f"{_fmt(_pct(sm['advance_tactical_coverage']), 0)} %; "
          f"stopping time / reach: largest error {_fmt(100 * sm['max_rel_error_stop_time_reach'], 2)} %; "
          f"overshoots: largest error {_fmt(sm['max_abs_overshoot_error_deg'], 3)}°.", ""]
     L += [f"![{f}]({f})" for f in figs] + [""]
