@@ -15,7 +15,7 @@ import tempfile
 import time
 
 from vtrials.scenario import load_scenario
-from vtrials.trialrun import simulate_agenda, write_agenda_outputs
+from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 
 
 def main() -> None:
@@ -27,7 +27,7 @@ def main() -> None:
     # load once first so the numba kernels are compiled / loaded before timing
     t0 = time.perf_counter()
     scn = load_scenario(a.scenario)
-    from vtrials.simulator import Simulator
+    from vtrials.physics.simulator import Simulator
     Simulator(scn.vessel, 1, scn.head.timestep_s).evaluate()
     t_load = time.perf_counter() - t0
     out = a.out or tempfile.mkdtemp(prefix="vtrials_bench_")

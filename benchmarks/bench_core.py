@@ -20,12 +20,12 @@ import time
 import mujoco
 import numpy as np
 
-from vtrials import helm as H
-from vtrials import truth_metrics as TM
-from vtrials.simulator import Simulator
-from vtrials.truth import ship_columns
+from vtrials.physics import steering as H
+from vtrials.truth import metrics as TM
+from vtrials.physics.simulator import Simulator
+from vtrials.truth.columns import ship_columns
 from vtrials.units import froude_to_speed, kn_to_mps
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 PRODUCTION_DT = {"kvlcc2": 0.05, "kvlcc2_l7": 0.01, "patrol51": 0.02}
 

@@ -21,10 +21,10 @@ import time
 import numpy as np
 
 from vtrials.instruments.suite import InstrumentSet
-from vtrials.run import _environment
+from vtrials.scenario import environment_block as _environment
 from vtrials.scenario import load_scenario
-from vtrials.simulator import Simulator
-from vtrials.truth import ship_columns
+from vtrials.physics.simulator import Simulator
+from vtrials.truth.columns import ship_columns
 
 SCENARIO = "scenarios/patrol51_standardization.toml"
 

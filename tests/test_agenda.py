@@ -9,14 +9,14 @@ import math
 import numpy as np
 import pytest
 
-from vtrials.agenda import Steadiness
-from vtrials.calmwater import steady_points, twin_points
+from vtrials.trials.agenda import Steadiness
+from vtrials.truth.calmwater import steady_points, twin_points
 from vtrials.cli import main
-from vtrials.crew import judge
-from vtrials.records import open_record, read_groups
-from vtrials.run import run
+from vtrials.trials.crew import judge
+from vtrials.records.netcdf import open_record, read_groups
+from vtrials.runner import run
 from vtrials.units import KNOT
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 HEAD = """
 [scenario]

@@ -9,8 +9,8 @@ import pytest
 
 from vtrials.cli import main
 from vtrials.errors import SimulationError
-from vtrials.simulator import ShipState, Simulator
-from vtrials.vessel import load_vessel
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.physics.vessel import load_vessel
 
 
 def test_nan_state_stops_with_time_and_state():

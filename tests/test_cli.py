@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from vtrials.cli import build_parser, main
-from vtrials.maneuvers import KINDS
+from vtrials.trials.programs import KINDS
 
 
 def test_help_texts(capsys):

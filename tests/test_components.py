@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import helm as H
-from vtrials.forces import layout as L
-from vtrials.simulator import ShipState, Simulator
+from vtrials.physics import steering as H
+from vtrials.physics.forces import context as L
+from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.units import froude_to_speed
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 U0 = froude_to_speed(0.142, 7.0)
 
@@ -96,7 +96,7 @@ def test_course_keeping_autopilot_recovers_heading(vessel):
 
 
 def test_williamson_turn_reaches_reciprocal(tmp_path, vessel):
-    from vtrials.run import simulate
+    from vtrials.runner.side_by_side import simulate
     from vtrials.scenario import load_scenario
     p = tmp_path / "w.toml"
     p.write_text("""

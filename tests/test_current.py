@@ -11,11 +11,11 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import helm as H
-from vtrials.sea import Current, current_at, current_numpy, pack
-from vtrials.simulator import Simulator
+from vtrials.physics import steering as H
+from vtrials.physics.environment.current import Current, current_at, current_numpy, pack
+from vtrials.physics.simulator import Simulator
 from vtrials.units import KNOT, froude_to_speed
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 
 def test_turn_in_uniform_current_is_translated_calm_turn():
@@ -105,7 +105,7 @@ def test_drifting_ship_moves_with_accelerating_water():
     v = load_vessel("kvlcc2_l7")
     cur = Current(tidal_amplitude_kn=1.0, tidal_direction_deg=45.0, tidal_period_h=60.0 / 3600.0)
     sim = Simulator(v, 1, 0.01, envs=pack(cur, 100.0))
-    from vtrials.simulator import ShipState
+    from vtrials.physics.simulator import ShipState
     sim.set_state(0, ShipState(heading=0.3, shaft_rps=(0.0,)))
     sim.step(6000)
     tr = sim.truth()

@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from vtrials.simulator import ShipState, Simulator
-from vtrials.vessel import load_vessel
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.physics.vessel import load_vessel
 
 
 def skew(a):
@@ -123,7 +123,7 @@ def test_ideal_fluid_invariants(vessel):
 
 def test_kernel_coriolis_is_power_free(vessel):
     """νᵀ C(ν)ν = 0 for the kernel's Coriolis vector (with Munk terms): it does no work."""
-    from vtrials.dynamics import coriolis
+    from vtrials.physics.dynamics import coriolis
     rng = np.random.default_rng(3)
     out = np.zeros(6)
     for M in (vessel.M_RB, vessel.M_A, vessel.M_RB + vessel.M_A):

@@ -18,8 +18,8 @@ import pytest
 from scipy.linalg import eig
 from scipy.optimize import curve_fit
 
-from vtrials.simulator import ShipState, Simulator
-from vtrials.vessel import load_vessel
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.physics.vessel import load_vessel
 
 
 def linear_modes(v):

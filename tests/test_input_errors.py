@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from vtrials.cli import main
-from vtrials.vessel import MODELS_DIR
+from vtrials.physics.vessel import MODELS_DIR
 
 GOOD_SCENARIO = """
 [scenario]

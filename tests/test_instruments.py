@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import helm as H
+from vtrials.physics import steering as H
 from vtrials.instruments.devices import Knotmeter, Loran, RangeRadar
 from vtrials.instruments.suite import InstrumentSet, load_catalogue
-from vtrials.simulator import ShipState, Simulator
-from vtrials.truth import ship_columns
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.truth.columns import ship_columns
 from vtrials.units import DEG, KNOT
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 SITE = {"transponders": [[-10000.0, -6000.0], [-10000.0, 6000.0]], "transponder_side": -1.0,
         "hydrophones": [[-600.0, -800.0], [-600.0, 800.0]], "hydrophone_side": -1.0, "water_depth_m": 200.0}

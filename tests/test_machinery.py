@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from vtrials import helm as H
+from vtrials.physics import steering as H
 from vtrials.cli import main
-from vtrials.simulator import ShipState, Simulator
-from vtrials.vessel import MODELS_DIR, load_vessel
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.physics.vessel import MODELS_DIR, load_vessel
 
 
 @pytest.fixture(scope="module")

@@ -9,15 +9,15 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import helm as H
+from vtrials.physics import steering as H
 from vtrials.cli import main
 from vtrials.reduce.estimate import Estimate
 from vtrials.reduce.maneuvering import DriftLine, periodic_steady_window
 from vtrials.reduce.turning import Drift, steady_window
-from vtrials.run import run
-from vtrials.simulator import Simulator
+from vtrials.runner import run
+from vtrials.physics.simulator import Simulator
 from vtrials.units import DEG
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 HEAD = """
 [scenario]

@@ -14,12 +14,12 @@ import math
 import pytest
 
 from tests.reference import mmg3dof as ref
-from vtrials import helm as H
-from vtrials.run import simulate
+from vtrials.physics import steering as H
+from vtrials.runner.side_by_side import simulate
 from vtrials.scenario import load_scenario
-from vtrials.simulator import Simulator
+from vtrials.physics.simulator import Simulator
 from vtrials.units import froude_to_speed
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 U0 = froude_to_speed(0.142, 7.0)
 
@@ -101,8 +101,8 @@ def test_planar_mode_converges_to_reference(n_ref):
         s = sim.self_propulsion(0, U0)
         sim.set_helm(0, [(H.HOLD, math.radians(35.0))])
         sim.step(int(round(70.0 / dt)))
-        from vtrials.truth import ship_columns
-        from vtrials import truth_metrics as TM
+        from vtrials.truth.columns import ship_columns
+        from vtrials.truth import metrics as TM
         c = ship_columns(sim.truth(), sim.rec_names, 0)
         m = TM.turning(c["t"], c["x_w"], c["y_w"], c["heading"], c["u_r"], c["v_r"], c["r"])
         errs.append(abs(m["tactical_diameter_m"] / res["tactical_diameter_m"] - 1)

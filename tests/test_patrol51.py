@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import helm as H
-from vtrials.run import simulate
+from vtrials.physics import steering as H
+from vtrials.runner.side_by_side import simulate
 from vtrials.scenario import load_scenario
-from vtrials.simulator import Simulator
-from vtrials.vessel import load_vessel
+from vtrials.physics.simulator import Simulator
+from vtrials.physics.vessel import load_vessel
 
 
 @pytest.fixture(scope="module")

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from vtrials.forces import bseries
-from vtrials.forces.propeller import K07, Propeller, coefficients, fit_section_model, pack
-from vtrials.vessel import load_vessel
+from vtrials.physics.forces import bseries
+from vtrials.physics.forces.propeller import K07, Propeller, coefficients, fit_section_model, pack
+from vtrials.physics.vessel import load_vessel
 
 # K_T read off the published B4-70 open-water diagram (Wageningen B-screw series, as drawn by Kuiper
 # 1992, "The Wageningen propeller series", MARIN publication 92-001; digitized points). Chart
@@ -143,7 +143,7 @@ def test_b_series_section_model_not_just_any_fit():
     pr = Propeller(name="x", diameter=1.0, x=0, y=0, z=0, t_P=0.1, w_P0=0.1, curve="bseries", blades=4,
                    area_ratio=0.7, pitch_ratio=1.0)
     p, _ = fit_section_model(pr)
-    from vtrials.forces.propeller import section_coefficients
+    from vtrials.physics.forces.propeller import section_coefficients
     for pd in (0.6, 0.8, 1.2, 1.4):
         ct, _ = section_coefficients(np.array([0.0]), math.atan(pd / K07), p)
         kt_model = ct[0] * math.pi * K07 ** 2 / 8

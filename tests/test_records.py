@@ -12,8 +12,8 @@ import time
 import numpy as np
 import pytest
 
-from vtrials.records import RecordError, open_record, read_groups, write_groups
-from vtrials.run import simulate, write_outputs
+from vtrials.records.netcdf import RecordError, open_record, read_groups, write_groups
+from vtrials.runner.side_by_side import simulate, write_outputs
 from vtrials.scenario import load_scenario
 
 
@@ -99,7 +99,7 @@ def test_killed_writer_leaves_no_partial_file(tmp_path):
     target = tmp_path / "big.nc"
     script = textwrap.dedent(f"""
         import numpy as np, time, h5netcdf.core as core
-        from vtrials.records import write_groups
+        from vtrials.records.netcdf import write_groups
         real = core.Group.create_variable
         def slow(self, *a, **k):
             time.sleep(0.05)

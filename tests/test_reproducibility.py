@@ -8,7 +8,7 @@ import json
 import numpy as np
 
 from vtrials.cli import main
-from vtrials.run import simulate
+from vtrials.runner.side_by_side import simulate
 from vtrials.scenario import load_scenario
 
 

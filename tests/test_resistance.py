@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vtrials.resistance import (KNOT, PATROL51_R_NOMINAL, Appendage, HullForm, holtrop_mennen,
+from vtrials.physics.resistance import (KNOT, PATROL51_R_NOMINAL, Appendage, HullForm, holtrop_mennen,
                                 ittc1957_cf, patrol51_hullform, patrol51_resistance_table,
                                 wave_resistance)
 
@@ -299,8 +299,8 @@ def test_patrol51_note_table_matches_the_code():
 def test_patrol51_blended_curve_and_model_file():
     """The model file's table is the blended curve: the BC93-calibrated factor up to 8 m/s, 1.3 × Holtrop
     from 30 kn, monotone in between."""
-    from vtrials.resistance import patrol51_blended_resistance, patrol51_resistance_table
-    from vtrials.vessel import load_vessel
+    from vtrials.physics.resistance import patrol51_blended_resistance, patrol51_resistance_table
+    from vtrials.physics.vessel import load_vessel
     V = np.arange(0.0, 16.5, 0.25)
     b = patrol51_blended_resistance(V)
     c = patrol51_resistance_table(V)

@@ -26,11 +26,11 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import helm as H
-from vtrials.simulator import ShipState, Simulator
-from vtrials.steadyturn import hysteresis, steady_turn, steady_turn_at_rudder, steady_turning_curve
+from vtrials.physics import steering as H
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.truth.steadyturn import hysteresis, steady_turn, steady_turn_at_rudder, steady_turning_curve
 from vtrials.units import DEG, RPM
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 DT = 0.05
 TOL = 1e-3  # relative agreement asked of the steady turns (the brief's 0.5 %, tightened)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from vtrials import truth_metrics as TM
+from vtrials.truth import metrics as TM
 
 
 def synthetic_turn(R=100.0, U=5.0, psi0=0.4, side=1, t_end=400.0, dt=0.05, transient=20.0):

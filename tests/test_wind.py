@@ -24,9 +24,9 @@ import pytest
 from scipy import integrate, signal
 from scipy.special import gamma as G
 
-from vtrials import sea
-from vtrials import wind as W
-from vtrials.forces import layout as L
+from vtrials.physics.environment import current as sea
+from vtrials.physics.environment import wind as W
+from vtrials.physics.forces import context as L
 
 DEG = math.pi / 180.0
 
@@ -333,7 +333,7 @@ def _run_kernel(p, env, u, v, w_, R, t=0.0):
     ctx[L.ROT:L.ROT + 9] = R.ravel()
     ctx[L.TIME] = t
     out = np.full(6, np.nan)
-    W.wind_kernel(p, env, ctx, np.zeros(L.NAUX), out)
+    W.wind_kernel(p, np.zeros(0), env, ctx, np.zeros(L.NAUX), out)
     return out, ctx
 
 
@@ -419,11 +419,11 @@ def test_kernel_is_allocation_free():
         pytest.skip("numba NRT statistics not available")
 
     @nb.njit
-    def drive(n, p, env, ctx, aux, w):
+    def drive(n, p, st, env, ctx, aux, w):
         s = 0.0
         for i in range(n):
             ctx[L.TIME] = 0.1 * i
-            W.wind_kernel(p, env, ctx, aux, w)
+            W.wind_kernel(p, st, env, ctx, aux, w)
             s += w[0]
         return s
 
@@ -432,7 +432,7 @@ def test_kernel_is_allocation_free():
                           gusts=W.gust_components("npd", 12.0, 10.0, np.random.default_rng(1), 64))
     ctx = np.zeros(L.NCTX)
     ctx[L.ROT:L.ROT + 9] = np.eye(3).ravel()
-    args = (p, env, ctx, np.zeros(L.NAUX), np.zeros(6))
+    args = (p, np.zeros(0), env, ctx, np.zeros(L.NAUX), np.zeros(6))
     drive(1, *args)
     nrt.memsys_enable_stats()
     try:

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from scipy.signal import welch
 
-from vtrials import helm as H
-from vtrials import wind as W
-from vtrials.sea import Current, pack
-from vtrials.simulator import ShipState, Simulator
+from vtrials.physics import steering as H
+from vtrials.physics.environment import wind as W
+from vtrials.physics.environment.current import Current, pack
+from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.units import KNOT
-from vtrials.vessel import load_vessel
+from vtrials.physics.vessel import load_vessel
 
 
 def test_beam_wind_drift_and_heel_follow_the_loads():

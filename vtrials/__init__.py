@@ -2,6 +2,12 @@
 
 A ship model runs in MuJoCo inside a modelled sea; a virtual crew executes trial maneuvers;
 the truth is recorded and every result is scored against it. Start with :func:`run`.
+
+The package is laid out along the data flow (docs/architecture.md): ``physics`` → ``truth``
+(references) and ``instruments`` → ``records`` → ``reduce`` → ``score`` → ``report``, with ``trials``
+(agenda, crew, controllers) driving the physics and ``runner`` / ``cli`` composing the stages.
+Importing the package loads nothing heavy: the names below are resolved on first use, so
+``import vtrials.reduce`` never loads the simulator.
 """
 
 __version__ = "0.1.0"
@@ -35,20 +41,41 @@ def _numba_cache_dir() -> None:
         d.mkdir(parents=True, exist_ok=True)
     except OSError:
         return
-    import numba
+    import sys
 
-    numba.config.CACHE_DIR = str(d)
+    if "numba" in sys.modules:  # already imported: its configuration is read, set it directly
+        sys.modules["numba"].config.CACHE_DIR = str(d)
+    else:  # numba reads this when it is first imported (and spawned workers inherit it)
+        os.environ["NUMBA_CACHE_DIR"] = str(d)
 
 
 _numba_cache_dir()
 # numba's OpenMP workers must not spin between kernel calls: MuJoCo's batch threads need the cores
 __import__("os").environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-from .errors import InputError, SimulationError, VtrialsError  # noqa: E402
-from .run import RunResult, run, simulate  # noqa: E402
-from .scenario import load_scenario  # noqa: E402
-from .simulator import ShipState, Simulator  # noqa: E402
-from .vessel import load_vessel  # noqa: E402
+from vtrials.errors import InputError, SimulationError, VtrialsError  # noqa: E402
+
+_LAZY = {
+    "run": ("vtrials.runner", "run"),
+    "simulate": ("vtrials.runner.side_by_side", "simulate"),
+    "RunResult": ("vtrials.runner.side_by_side", "RunResult"),
+    "load_scenario": ("vtrials.scenario", "load_scenario"),
+    "load_vessel": ("vtrials.physics.vessel", "load_vessel"),
+    "Simulator": ("vtrials.physics.simulator", "Simulator"),
+    "ShipState": ("vtrials.physics.simulator", "ShipState"),
+}
+
+
+def __getattr__(name: str):
+    """Resolve the public API on first use (PEP 562), so that importing one stage loads no other."""
+    if name in _LAZY:
+        import importlib
+        mod, attr = _LAZY[name]
+        value = getattr(importlib.import_module(mod), attr)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'vtrials' has no attribute {name!r}")
+
 
 __all__ = ["run", "simulate", "load_scenario", "load_vessel", "Simulator", "ShipState", "RunResult",
            "InputError", "SimulationError", "VtrialsError", "__version__"]

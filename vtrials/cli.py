@@ -6,12 +6,12 @@ import argparse
 import sys
 import textwrap
 
-from . import __version__
-from .errors import InputError, SimulationError, VtrialsError
+from vtrials import __version__
+from vtrials.errors import InputError, SimulationError, VtrialsError
 
 
 def _fields(cls, indent="    ") -> str:
-    from .schema import doc_table
+    from vtrials.schema import doc_table
     lines = []
     for name, allowed, doc in doc_table(cls):
         lines.append(f"{indent}{name:<22} {doc} — {allowed}")
@@ -19,9 +19,9 @@ def _fields(cls, indent="    ") -> str:
 
 
 def _scenario_help() -> str:
-    from .maneuvers import KINDS
-    from .scenario import Environment, Head, Initial
-    from .sea import Current
+    from vtrials.trials.programs import KINDS
+    from vtrials.scenario import Environment, Head, Initial
+    from vtrials.physics.environment.current import Current
     parts = [
         "Scenario file (TOML). Tables and fields (units at the edge: kn, deg; SI inside):",
         "  [scenario]", _fields(Head),
@@ -33,7 +33,7 @@ def _scenario_help() -> str:
     for kind, cls in KINDS.items():
         parts.append(f"    kind = \"{kind}\": {textwrap.shorten(cls.__doc__ or '', 150)}")
         parts.append(_fields(cls, indent="      "))
-    from .agenda import AgendaRules, SpeedSpec, SpotSpec, Steadiness, TrialHead
+    from vtrials.trials.agenda import AgendaRules, SpeedSpec, SpotSpec, Steadiness, TrialHead
     parts += [
         "", "  [agenda]   instead of maneuvers: a trial agenda run by the virtual crew on one ship", _fields(AgendaRules),
         "  [agenda.steadiness]   how the director judges a steady approach", _fields(Steadiness),
@@ -93,7 +93,7 @@ def _inspect(args) -> int:
 
     import numpy as np
 
-    from .records import RecordError, open_record
+    from vtrials.records.netcdf import RecordError, open_record
     try:
         rec = open_record(args.record)
     except FileNotFoundError:
@@ -128,7 +128,7 @@ def _inspect(args) -> int:
         axes[-1, 0].set_xlabel("time [s] (dashed: event marks)")
         fig.tight_layout()
         out = Path(args.out) if args.out else Path(args.record).with_suffix(".png")
-        from .records import atomic_path
+        from vtrials.records.netcdf import atomic_path
         with atomic_path(out) as tmp:
             fig.savefig(tmp, dpi=100, format="png")
         plt.close(fig)
@@ -138,7 +138,7 @@ def _inspect(args) -> int:
 
 def _run_agenda(scn, args) -> int:
     """An agenda: the crew's progress per run, then the scores of every trial."""
-    from .trialrun import simulate_agenda, write_agenda_outputs
+    from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
     say = None if args.quiet else (lambda line: print(line, flush=True))
     if say:
         say(f"vtrials: {scn.head.title} — agenda of {len(scn.agenda.runs)} runs, ship {scn.vessel.name}")
@@ -162,13 +162,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         if args.command == "models":
-            from .vessel import available_models, load_vessel
+            from vtrials.physics.vessel import available_models, load_vessel
             for name in available_models():
                 v = load_vessel(name)
                 print(f"{name:<14} {v.meta.title}")
             return 0
         if args.command == "run":
-            from .run import load_scenario, simulate, write_outputs
+            from vtrials.scenario import load_scenario
+            from vtrials.runner.side_by_side import simulate, write_outputs
             if args.threads < 1:
                 raise InputError("--threads", "", "must be at least 1")
             scn = load_scenario(args.scenario)

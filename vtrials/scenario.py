@@ -23,13 +23,15 @@ import dataclasses
 import math
 from pathlib import Path
 
-from .errors import InputError
-from .maneuvers import KINDS, ORDER_CHOICES
-from .wind import Wind
-from .schema import flag, integer, load_toml, num, read_table, text, unknown_key
-from .sea import Current
-from .units import DEG, KNOT, froude_to_speed
-from .vessel import Vessel, load_vessel
+import numpy as np
+
+from vtrials.errors import InputError
+from vtrials.trials.programs import KINDS, ORDER_CHOICES
+from vtrials.physics.environment.wind import Wind
+from vtrials.schema import flag, integer, load_toml, num, read_table, text, unknown_key
+from vtrials.physics.environment.current import Current
+from vtrials.units import DEG, KNOT, froude_to_speed
+from vtrials.physics.vessel import Vessel, load_vessel
 
 
 @dataclasses.dataclass(frozen=True)
@@ -207,11 +209,11 @@ def load_scenario(path: str | Path) -> Scenario:
             "water_depth_m": env.water_depth_m}
     agenda = None
     if has_agenda:
-        from .agenda import load_agenda
+        from vtrials.trials.agenda import load_agenda
         agenda = load_agenda(doc["agenda"], vessel, f)
     scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []), agenda)
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
-    from .instruments.suite import InstrumentSet
+    from vtrials.instruments.suite import InstrumentSet
     InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
     if given and init.engine_order is None and scn.speed > 0.9 * _runaway_speed(vessel):
         raise InputError(f, "initial", f"approach speed {scn.speed:.2f} m/s is beyond this hull model's range")
@@ -219,5 +221,14 @@ def load_scenario(path: str | Path) -> Scenario:
 
 
 def _runaway_speed(vessel: Vessel) -> float:
-    from .units import G
+    from vtrials.units import G
     return 2.0 * math.sqrt(G * vessel.length)
+
+
+def environment_block(scn: Scenario) -> np.ndarray:
+    """The sea (current, wind with its gusts drawn from the scenario seed) as an environment block."""
+    from vtrials.physics.environment.current import pack as pack_current
+    from vtrials.physics.environment.wind import pack_env as pack_wind
+    env = pack_current(scn.current, scn.environment.water_depth_m)
+    gust_seed, = np.random.SeedSequence(scn.head.seed).spawn(1)
+    return pack_wind(scn.wind, env, np.random.default_rng(gust_seed))

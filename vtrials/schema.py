@@ -22,7 +22,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from .errors import InputError
+from vtrials.errors import InputError
 
 _SPEC = "vtrials_spec"
 

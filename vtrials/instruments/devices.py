@@ -15,9 +15,9 @@ import math
 import numba as nb
 import numpy as np
 
-from ..units import DEG, KNOT, RPM
-from . import parts as P
-from .kinematics import SiteKinematics
+from vtrials.units import DEG, KNOT, RPM
+from vtrials.instruments import parts as P
+from vtrials.instruments.kinematics import SiteKinematics
 
 UNIT_FACTORS = {"m": 1.0, "deg": DEG, "kn": KNOT, "m/s": 1.0, "rpm": RPM, "N m": 1.0, "N": 1.0, "1": 1.0,
                 "SI": 1.0, "m/s2": 1.0, "deg/s": DEG}

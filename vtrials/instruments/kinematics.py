@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import G
+from vtrials.units import G
 
 
 def rotation_matrices(qw, qx, qy, qz) -> np.ndarray:

@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..schema import load_toml, num, read_table, text, unknown_key
-from .devices import KINDS, RudderAngle, ShaftDevice, SpecError
+from vtrials.errors import InputError
+from vtrials.schema import load_toml, num, read_table, text, unknown_key
+from vtrials.instruments.devices import KINDS, RudderAngle, ShaftDevice, SpecError
 
 CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
 SEED_KEY = 4  # spawn-key namespace of instrument streams
@@ -109,7 +109,7 @@ class InstrumentSet:
                 "propeller_diameters_m": [pr.diameter for pr in v.propellers],
                 "max_power_W": [s.max_power for s in v.shafts]}
         if v.windage is not None:
-            from ..wind import wind_coefficients
+            from vtrials.physics.environment.wind import wind_coefficients
             ang = np.radians(np.arange(0.0, 181.0, 10.0))
             cx, cy, cn, ck = wind_coefficients(ang, v.windage)
             w = v.windage

@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from vtrials.records import Record
+from vtrials.records.netcdf import Record
 from vtrials.reduce import imo as IMO
 from vtrials.reduce import reach as RE
 from vtrials.reduce import spiral as SPI

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from scipy import optimize
 
-from vtrials.records import Record
+from vtrials.records.netcdf import Record
 from vtrials.reduce import current as CUR
 from vtrials.reduce import logcal as LC
 from vtrials.reduce import runstats as RS

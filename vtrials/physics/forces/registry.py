@@ -1,0 +1,152 @@
+"""The force-component registry: a component is a compiled kernel plus its own parameters and states.
+
+A force component is a numba kernel
+
+    kernel(p, s, env, ctx, aux, w)
+
+* ``p``   – the component's parameter block for this ship (float64; packed by the component's own
+  ``pack``; per ship, so ships of one batch may differ, e.g. in their wave realization),
+* ``s``   – the component's internal states for this ship (float64, possibly empty): radiation memory,
+  filter or actuator-lag states. On entry they hold the value at the start of the step; the kernel
+  advances them to the end of the step (``ctx[DT]`` is the step). The simulator passes a scratch copy
+  when it only evaluates forces, so evaluation has no side effects;
+* ``env`` – the ship's environment block (current, wind, ...), ``ctx`` – the kinematic context and
+  ``aux`` – outputs shared between components (see :mod:`vtrials.physics.forces.context`),
+* ``w``   – the wrench written by the component: X, Y, Z [N], K, M, N [N m] in body axes at the origin.
+
+A kernel is made known with :func:`register` (in its own module, at import). The step kernel of the
+dynamics (:mod:`vtrials.physics.dynamics`) never names a component: for the set of component types a
+simulator uses, :func:`dispatcher` writes a small dispatch function (``if kind == 0: k0(...) elif
+...``) to a file in numba's cache directory, and the step kernel is compiled against it. Adding a
+component therefore touches its own file and a ``register`` call, not the kernel.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclasses.dataclass(frozen=True)
+class ComponentType:
+    """A registered kernel: its registry name, the module that defines it and the kernel's name there."""
+
+    name: str
+    module: str
+    attr: str
+
+    def kernel(self):
+        return getattr(importlib.import_module(self.module), self.attr)
+
+
+_TYPES: dict[str, ComponentType] = {}
+
+
+def register(name: str, kernel) -> ComponentType:
+    """Register ``kernel`` (a ``numba.njit`` function with the component signature) under ``name``.
+
+    The kernel must be reachable as a module attribute (``module.attr``) so that the generated
+    dispatcher can import it. Registering the same kernel twice under one name is allowed.
+    """
+    py = getattr(kernel, "py_func", None)
+    if py is None:
+        raise TypeError(f"component {name!r}: the kernel must be a numba.njit function")
+    ct = ComponentType(name, py.__module__, py.__name__)
+    mod = sys.modules.get(ct.module)
+    if mod is None or getattr(mod, ct.attr, None) is not kernel:
+        raise ValueError(f"component {name!r}: the kernel must be importable as {ct.module}.{ct.attr}")
+    old = _TYPES.get(name)
+    if old is not None and old != ct:
+        raise ValueError(f"component type {name!r} is already registered for {old.module}.{old.attr}")
+    _TYPES[name] = ct
+    return ct
+
+
+def component_type(name: str) -> ComponentType:
+    try:
+        return _TYPES[name]
+    except KeyError:
+        raise KeyError(f"unknown force component type {name!r}; registered: {', '.join(sorted(_TYPES))}") from None
+
+
+@dataclasses.dataclass
+class Component:
+    """One named force component of a ship: its registered type, parameter block and initial states."""
+
+    name: str
+    type: str
+    params: np.ndarray
+    states: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self):
+        component_type(self.type)  # fail early on an unknown type
+        self.params = np.ascontiguousarray(self.params, dtype=np.float64).ravel()
+        self.states = np.ascontiguousarray(self.states, dtype=np.float64).ravel()
+
+
+def _source_stamp(ct: ComponentType) -> str:
+    """Hash of the kernel's module source: a cached step kernel must not outlive a changed component."""
+    try:
+        return hashlib.sha256(Path(inspect.getfile(sys.modules[ct.module])).read_bytes()).hexdigest()[:12]
+    except (OSError, TypeError, KeyError):
+        return "nosource"
+
+
+def _cache_root() -> Path:
+    import numba
+    d = numba.config.CACHE_DIR or os.environ.get("NUMBA_CACHE_DIR") or tempfile.gettempdir()
+    return Path(d) / "vtrials_dispatch"
+
+
+_LOADED: dict[str, object] = {}
+
+
+def dispatcher(types: list[ComponentType]):
+    """``(dispatch, tag)``: a compiled ``dispatch(kind, p, s, env, ctx, aux, w)`` calling ``types[kind]``.
+
+    The source is generated, written once to numba's cache directory under a name keyed by the types
+    and their modules' sources, and imported from there, so numba caches it like any other kernel.
+    """
+    key = "|".join(f"{t.name}={t.module}.{t.attr}@{_source_stamp(t)}" for t in types)
+    tag = hashlib.sha256(key.encode()).hexdigest()[:16]
+    if tag in _LOADED:
+        return _LOADED[tag], tag
+    lines = ['"""Generated by vtrials.physics.forces.registry; do not edit."""', "import math",
+             "import numba as nb"]
+    for k, t in enumerate(types):
+        lines.append(f"from {t.module} import {t.attr} as _k{k}")
+    lines += ["", "", "@nb.njit(cache=True)", "def dispatch(kind, p, s, env, ctx, aux, w):"]
+    for k, t in enumerate(types):
+        lines.append(f"    {'if' if k == 0 else 'elif'} kind == {k}:  # {t.name}")
+        lines.append(f"        _k{k}(p, s, env, ctx, aux, w)")
+    if types:
+        lines.append("    else:")
+        lines.append("        for j in range(6):")
+        lines.append("            w[j] = math.nan")
+    else:
+        lines.append("    for j in range(6):")
+        lines.append("        w[j] = math.nan")
+    src = "\n".join(lines) + "\n"
+    root = _cache_root()
+    root.mkdir(parents=True, exist_ok=True)
+    path = root / f"dispatch_{tag}.py"
+    if not path.exists() or path.read_text() != src:
+        fd, tmp = tempfile.mkstemp(dir=root, suffix=".tmp")
+        with os.fdopen(fd, "w") as f:
+            f.write(src)
+        os.replace(tmp, path)
+    name = f"vtrials_dispatch_{tag}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    _LOADED[tag] = mod.dispatch
+    return mod.dispatch, tag

@@ -1,0 +1,304 @@
+"""Running an agenda: crew → records → reductions → scoring → report.
+
+The flow of one trial day (architecture.md):
+
+1. :func:`simulate_agenda` — one ship, the virtual crew executes every run; instruments stream the
+   truth; per-run truth references are taken at each FINEX; the calm-water truth at every setting the
+   crew used is computed by :mod:`vtrials.calmwater`.
+2. :func:`write_agenda_outputs` — ``truth.nc`` (state history, drawn instrument errors, per-run truth
+   references), ``records/<trial>.nc`` (what the team has), then the reductions — which read the
+   record FILES just written, through :mod:`vtrials.records`, never the in-memory truth — then the
+   scoring against truth, ``results.json`` (a ``trials`` list with ``reduced``, ``truth`` and
+   ``error`` per trial) and ``report.md`` with PNG figures.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from vtrials import __version__
+from vtrials.trials.crew import Crew
+from vtrials.errors import InputError, SimulationError
+from vtrials.instruments.suite import InstrumentSet
+from vtrials.records.netcdf import atomic_path, open_record, write_groups
+from vtrials.scenario import Scenario, environment_block
+from vtrials.runner.outputs import json_clean
+from vtrials.physics.simulator import ShipState, Simulator
+from vtrials.records.trial import write_record
+from vtrials.truth.columns import describe
+from vtrials.units import DEG, RPM
+
+
+@dataclasses.dataclass
+class AgendaResult:
+    scenario: Scenario
+    crew: Crew
+    simulated_time_s: float
+    wall_time_s: float
+    calm_water: dict  # trial name → list of calm-water truth points per accepted group
+    timings: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def attempts(self):
+        return self.crew.attempts
+
+
+def _initial_state(sim: Simulator, scn: Scenario) -> ShipState:
+    """Steady at the first run's setting on its course, or the scenario's [initial] if it has one."""
+    v = scn.vessel
+    first = scn.agenda.runs[0]
+    f = str(scn.path)
+    init = scn.initial
+    heading = first.heading
+    try:
+        if init.engine_order is not None:
+            rps, pitch = v.telegraph[init.engine_order]
+            s = sim.steady_at_order(0, (rps,) * sim.ns, (pitch,) * sim.ns if pitch is not None else (),
+                                    heading=init.heading_deg * DEG)
+        elif any(getattr(init, k) is not None for k in ("froude_number", "speed_kn", "speed_mps")):
+            s = sim.self_propulsion(0, scn.speed, init.heading_deg * DEG)
+        else:
+            gov = [k for k, m in enumerate(first.modes) if m == "governed"]
+            s = sim.steady_at_order(0, (first.rps,) * sim.ns,
+                                    (first.pitch,) * sim.ns if first.pitch is not None else (), heading=heading)
+            if len(gov) < sim.ns:
+                s = dataclasses.replace(s, shaft_modes=tuple(first.modes))
+    except SimulationError as exc:
+        raise InputError(f, "initial", f"the machinery cannot give the starting condition: {exc}") from None
+    rules = scn.agenda.rules
+    if rules.measured_course and abs(s.heading - heading) < 1e-9:
+        # start on the first run's line, far enough before the range centre to settle and approach
+        back = abs(s.u) * (2.0 * rules.runout_s + rules.approach_s + 0.5 * first.duration)
+        c = scn.site.get("range_center", [0.0, 0.0])
+        s = dataclasses.replace(s, x=c[0] - back * math.cos(heading), y=c[1] - back * math.sin(heading))
+    sim.set_state(0, s)
+    return s
+
+
+def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
+    t_wall = time.perf_counter()
+    timings = {}
+    vessel = scn.vessel
+    sim = Simulator(vessel, 1, scn.head.timestep_s, environment_block(scn), record_every=scn.head.record_every)
+    _initial_state(sim, scn)
+    iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path))
+    iset.reset()
+    crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)
+    crew.run_agenda()
+    t_ins = time.perf_counter()
+    iset.flush()
+    crew.instrument_wall_s += time.perf_counter() - t_ins
+    timings["simulate_s"] = time.perf_counter() - t_wall
+    timings["instruments_s"] = crew.instrument_wall_s
+    t1 = time.perf_counter()
+    calm = calm_water_truth(scn, crew)
+    calm.update(spiral_truth(scn, crew))
+    timings["calm_water_s"] = time.perf_counter() - t1
+    return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings)
+
+
+def _accepted(crew: Crew, trial: str) -> list:
+    return [a for a in crew.attempts if a.accepted and a.run.trial == trial]
+
+
+def calm_water_truth(scn: Scenario, crew: Crew) -> dict:
+    """Per standardization trial: calm-water twins at the settings the crew actually used for each
+    spot (the last accepted run's per-shaft orders), plus midpoints between consecutive spots of the
+    same shaft modes so the true curve is densely known between spots."""
+    from vtrials.truth.calmwater import twin_points
+    out = {}
+    for trial in scn.agenda.trials:
+        if trial.head.kind != "standardization":
+            continue
+        acc = _accepted(crew, trial.head.name)
+        groups = sorted({a.run.group for a in acc})
+        settings = []
+        for g in groups:
+            a = [x for x in acc if x.run.group == g][-1]
+            settings.append({"group": g, "rps": [r * RPM for r in a.rpm_ordered],
+                             "pitch": a.pitch_ordered if a.pitch_ordered[0] is not None else None,
+                             "modes": list(a.modes)})
+        extra = []
+        # the two ends, a little beyond the measured range (the reduced speeds scatter about the spots)
+        for st, f in ((settings[0], 0.96), (settings[-1], 1.03)):
+            gov = [k for k, m in enumerate(st["modes"]) if m == "governed"]
+            rps = [r * f if k in gov else r for k, r in enumerate(st["rps"])]
+            if all(r <= sh.max_rps for r, sh in zip(rps, scn.vessel.shafts)):
+                extra.append({**st, "group": None, "rps": rps})
+        for s0, s1 in zip(settings, settings[1:]):
+            if s0["modes"] == s1["modes"]:
+                mid = {"group": None, "modes": s0["modes"],
+                       "rps": [0.5 * (a + b) for a, b in zip(s0["rps"], s1["rps"])],
+                       "pitch": None if s0["pitch"] is None else [0.5 * (a + b) for a, b in zip(s0["pitch"], s1["pitch"])]}
+                extra.append(mid)
+        pts = twin_points(scn.vessel, settings + extra, scn.head.timestep_s)
+        for s, p in zip(settings + extra, pts):
+            p.update({"group": s["group"], "modes": s["modes"], "rps_order": s["rps"], "pitch_order": s["pitch"]})
+        out[trial.head.name] = pts
+    return out
+
+
+def spiral_truth(scn: Scenario, crew: Crew) -> dict:
+    """For every spiral run: the steady-turning curve δ(r) of the model's own equations at the run's
+    shaft settings (calm deep water) and its hysteresis loop (:mod:`vtrials.steadyturn`)."""
+    from vtrials.truth.steadyturn import hysteresis, steady_turning_curve
+    out = {}
+    cache = {}
+    for a in crew.attempts:
+        if not a.accepted or a.run.kind not in ("direct_spiral", "reverse_spiral"):
+            continue
+        rps = tuple(r * RPM for r in a.rpm_ordered)
+        pitch = tuple(p for p in a.pitch_ordered) if a.pitch_ordered and a.pitch_ordered[0] is not None else ()
+        key = (rps, pitch)
+        if key not in cache:
+            curve = steady_turning_curve(scn.vessel, rps, pitch, dt=scn.head.timestep_s)
+            loop = hysteresis(curve)
+            cache[key] = {"curve": {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
+                                    for k, v in curve.items()},
+                          "hysteresis": {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
+                                         for k, v in loop.items()}}
+        out[f"spiral_run_{a.run.number}"] = cache[key]
+    return out
+
+
+# ----------------------------------------------------------------------------------- writing
+def write_agenda_truth(res: AgendaResult, path: Path) -> None:
+    crew = res.crew
+    s = res.scenario
+    rows = np.concatenate(crew.truth_rows, axis=0) if crew.truth_rows else np.zeros((0, len(crew.names)))
+    variables = {}
+    for j, name in enumerate(crew.names):
+        if name == "t":
+            continue
+        units, long_name = describe(name)
+        variables[name] = (rows[:, j], units, long_name)
+    attrs = {"kind": "agenda", "instrument_errors": json.dumps(crew.iset.drawn(), sort_keys=True),
+             "run_truth": json.dumps(crew.truth_refs), "calm_water": json.dumps(res.calm_water),
+             "truth_every": s.head.truth_every}
+    groups = {"agenda": {"time": rows[:, 0], "variables": variables, "attrs": attrs}}
+    write_groups(path, groups, {"Conventions": "CF-1.10", "title": f"vtrials truth: {s.head.title}",
+                                "content": "truth", "ship": s.vessel.name, "seed": s.head.seed,
+                                "timestep_s": s.head.timestep_s, "vtrials_version": __version__,
+                                "frames": "north-east-down world; body x forward, y starboard, z down at "
+                                          "midship waterline"})
+
+
+def write_trial_records(res: AgendaResult, out: Path) -> dict:
+    """One record per trial: the instruments over the trial's span, its events, orders and log sheet."""
+    crew = res.crew
+    s = res.scenario
+    paths = {}
+    for trial in s.agenda.trials:
+        name = trial.head.name
+        atts = [a for a in crew.attempts if a.run.trial == name]
+        t0, t1 = atts[0].t_start, atts[-1].t_finex
+        numbers = {a.run.number for a in atts}
+        events = [e for e in crew.events if e[1] in numbers]
+        orders = [o for o in crew.orders if t0 <= o[0] <= t1]
+        prior = [o for o in crew.orders if o[0] < t0]
+        if prior:
+            orders = [(t0, prior[-1][1])] + orders
+        settings = [st for st in crew.settings if t0 <= st[0] <= t1]
+        # the state of every shaft at the start of the trial (the engine-room log carries it over)
+        for k in range(crew.sim.ns):
+            before = [st for st in crew.settings if st[0] < t0 and st[1] == k]
+            if before:
+                settings.insert(0, (t0, *before[-1][1:]))
+        head = trial.head
+        path = out / "records" / f"{name}.nc"
+        write_record(path, crew.iset, t1, events, orders,
+                     f"vtrials trial record: {name} ({head.kind}) — {s.head.title}",
+                     {"trial": name, "kind": head.kind, "ship": s.vessel.name, "scenario_file": s.path.name,
+                      "run_log": [a.log() for a in atts],
+                      "condition": {"displacement_m3": head.displacement_m3 or s.vessel.particulars.displacement,
+                                    "trim_m": head.trim_m},
+                      "tank_prediction": tank_prediction(s.vessel)},
+                     t_start=t0, settings=sorted(settings))
+        paths[name] = path
+    return paths
+
+
+def tank_prediction(vessel) -> dict:
+    """What the towing tank told the trials team: calm-water resistance, delivered power and
+    propulsive efficiency η_D = R_T V / P_D at a few speeds (computed from the model's own equations,
+    i.e. a perfect tank test of this hull; the reductions use η_D only inside the resistance
+    corrections, as ITTC 7.5-04-01-01.1 does)."""
+    key = str(vessel.folder)
+    if key in _TANK_CACHE:
+        return _TANK_CACHE[key]
+    sim = Simulator(vessel, 1, 0.05, record_every=0)
+    vmax = max_speed(vessel, sim)
+    out = {"speed_mps": [], "resistance_N": [], "power_W": [], "eta_D": []}
+    hull = [i for i, n in enumerate(sim.comp_names) if n.startswith("hull")]
+    for f in np.linspace(0.25, 1.0, 7):
+        V = f * vmax
+        sim.self_propulsion(0, V)
+        P = float(sum(sim.shaft_power(0)))
+        R = -float(sum(sim.comp_w[0, i, 0] for i in hull))
+        out["speed_mps"].append(V)
+        out["resistance_N"].append(R)
+        out["power_W"].append(P)
+        out["eta_D"].append(R * V / P)
+    _TANK_CACHE[key] = out
+    return out
+
+
+_TANK_CACHE: dict = {}
+
+
+def max_speed(vessel, sim: Simulator) -> float:
+    """Calm-water speed at the highest ahead telegraph order (the tank table's range)."""
+    best = None
+    for order in ("flank", "full"):
+        if order in vessel.telegraph:
+            rps, pitch = vessel.telegraph[order]
+            s = sim.steady_at_order(0, (rps,) * sim.ns, (pitch,) * sim.ns if pitch is not None else ())
+            best = s.u
+            break
+    return best if best else 0.5 * math.sqrt(9.81 * vessel.length) * 0.3
+
+
+def write_agenda_outputs(res: AgendaResult, out_dir: str | Path, plot: bool = True) -> dict:
+    from vtrials.reduce.trials import reduce_record
+    from vtrials.report.trial_report import write_report
+    from vtrials.score.trials import score_trial
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise InputError(str(out), "--out", "exists and is not a directory")
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    write_agenda_truth(res, out / "truth.nc")
+    paths = write_trial_records(res, out)
+    t1 = time.perf_counter()
+    trials = []
+    for trial in res.scenario.agenda.trials:
+        name = trial.head.name
+        reduced = reduce_record(open_record(paths[name]))  # the reduction sees the record file only
+        scored = score_trial(trial.head.kind, reduced, res, name)
+        trials.append({"name": name, "kind": trial.head.kind, "record": f"records/{name}.nc", **scored})
+    t2 = time.perf_counter()
+    res.timings.update({"write_s": t1 - t0, "reduce_score_s": t2 - t1})
+    crew = res.crew
+    s = res.scenario
+    doc = {"vtrials_version": __version__, "scenario": s.head.title, "scenario_file": s.path.name,
+           "ship": s.vessel.name, "ship_length_m": s.vessel.length, "seed": s.head.seed,
+           "timestep_s": s.head.timestep_s, "simulated_time_s": res.simulated_time_s,
+           "wall_time_s": res.wall_time_s, "timings": res.timings,
+           "agenda": {"runs": [a.log() for a in crew.attempts],
+                      "trial_time_s": {t.head.name: sum(a.t_finex - a.t_start for a in crew.attempts
+                                                        if a.run.trial == t.head.name)
+                                       for t in s.agenda.trials},
+                      "total_time_s": crew.t},
+           "trials": trials}
+    doc = json_clean(doc)
+    if plot:
+        write_report(doc, res, out)
+    with atomic_path(out / "results.json") as tmp:
+        tmp.write_text(json.dumps(doc, indent=2) + "\n")
+    return doc
