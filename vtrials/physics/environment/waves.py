@@ -355,17 +355,6 @@ def wavenumber(omega, depth: float = math.inf):
 # =================================================================================================
 
 @nb.njit(cache=True)
-def _depth_factors(k, depth, z):
-    """(F_c, F_s) = (cosh k(h−z), sinh k(h−z)) / sinh kh in the overflow-free form (module doc)."""
-    e = math.exp(-k * z)
-    if math.isinf(depth):
-        return e, e
-    q = math.exp(-2.0 * k * (depth - z))
-    den = -math.expm1(-2.0 * k * depth)
-    return e * (1.0 + q) / den, e * (1.0 - q) / den
-
-
-@nb.njit(cache=True)
 def elevation_at(comp, x, y, t):
     """η [m] (up) at (x north, y east) [m] and time t [s]: Σ a cos(ω t − k(x cos μ + y sin μ) + ε)."""
     eta = 0.0
@@ -384,6 +373,7 @@ def kinematics_at(comp, depth, x, y, z, t):
     """
     if z < 0.0:
         z = 0.0
+    deep = math.isinf(depth)
     eta = 0.0
     un = 0.0
     ue = 0.0
@@ -400,7 +390,16 @@ def kinematics_at(comp, depth, x, y, z, t):
         th = w * t - k * (x * c + y * s) + comp[j, 5]
         ct = math.cos(th)
         st = math.sin(th)
-        fc, fs = _depth_factors(k, depth, z)
+        # depth factors F_c, F_s in the overflow-free form (module doc, section 5)
+        e = math.exp(-k * z)
+        if deep:
+            fc = e
+            fs = e
+        else:
+            q = math.exp(-2.0 * k * (depth - z))
+            e = e / -math.expm1(-2.0 * k * depth)
+            fc = e * (1.0 + q)
+            fs = e * (1.0 - q)
         aw = a * w
         eta += a * ct
         h = aw * fc * ct
