@@ -336,6 +336,18 @@ def test_single_component_matches_airy(depth):
     assert W.elevation_at(comp_e, 0.0, 10.0, 10.0 * k_e / w) == pytest.approx(1.0, abs=1e-12)
 
 
+def test_array_wrappers_broadcast_and_chunk_like_the_point_kernel():
+    f = W.realize(W.Waves(hs_m=2.0, tp_s=8.0, n_components=50), 30.0, np.random.default_rng(2))
+    x = np.linspace(-50.0, 50.0, 7)[:, None]
+    t = np.linspace(0.0, 900.0, 20001)[None, :]  # 140 007 points: three chunks of W.CHUNK
+    eta, vel, acc = W.kinematics(f.components, 30.0, x, 5.0, 2.0, t)
+    assert eta.shape == (7, 20001) and vel.shape == acc.shape == (7, 20001, 3)
+    np.testing.assert_array_equal(W.elevation(f.components, x, 5.0, t), eta)
+    for i, j in ((0, 0), (3, 12345), (6, 20000), (5, 19999)):
+        r = W.kinematics_at(f.components, 30.0, x[i, 0], 5.0, 2.0, t[0, j])
+        assert r == (eta[i, j], *vel[i, j], *acc[i, j])
+
+
 def test_very_large_kh_does_not_overflow():
     comp, k = _one(1.0, 6.0, 5000.0, 0.0, 0.0)  # kh ≈ 1.8e4: cosh/sinh overflow, our form does not
     assert k * 5000.0 > 1e4

@@ -420,11 +420,19 @@ def _elevation_many(comp, x, y, t, out):
 
 
 @nb.njit(cache=True)
-def _kinematics_many(comp, depth, x, y, z, t, out):
-    for i in range(out.shape[0]):
+def _kinematics_many(comp, depth, x, y, z, t, o0, o1, o2, o3, o4, o5, o6):
+    for i in range(o0.shape[0]):
         r = kinematics_at(comp, depth, x[i], y[i], z[i], t[i])
-        for m in range(7):
-            out[i, m] = r[m]
+        o0[i] = r[0]
+        o1[i] = r[1]
+        o2[i] = r[2]
+        o3[i] = r[3]
+        o4[i] = r[4]
+        o5[i] = r[5]
+        o6[i] = r[6]
+
+
+CHUNK = 65536  # points per compiled call in the array wrappers (bounds the temporaries)
 
 
 def _check_components(comp) -> np.ndarray:
@@ -434,33 +442,44 @@ def _check_components(comp) -> np.ndarray:
     return comp
 
 
+def _chunks(inputs, outputs):
+    """Buffered 1-D chunks of broadcast inputs and matching output views (numpy.nditer)."""
+    ops = [np.asarray(v, dtype=np.float64) for v in inputs] + list(outputs)
+    flags = [["readonly"]] * len(inputs) + [["writeonly"]] * len(outputs)
+    it = np.nditer(ops, flags=["external_loop", "buffered", "zerosize_ok"], op_flags=flags,
+                   buffersize=CHUNK, order="C")
+    with it:
+        yield from it
+
+
 def elevation(comp, x, y, t):
-    """η [m] for arrays of x, y [m] and t [s] (broadcast together); one compiled loop, O(points) memory."""
+    """η [m] for arrays of x, y [m] and t [s] (broadcast together), evaluated in compiled chunks.
+
+    Memory: the output plus O(CHUNK) buffers — never (points × components) temporaries.
+    """
     comp = _check_components(comp)
-    b = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, t)))
-    shape = b[0].shape
-    flat = [np.ascontiguousarray(v).ravel() for v in b]
-    out = np.empty(flat[0].size)
-    _elevation_many(comp, flat[0], flat[1], flat[2], out)
-    return out.reshape(shape)
+    shape = np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(t))
+    out = np.empty(shape)
+    for cx, cy, ct, co in _chunks((x, y, t), (out,)):
+        _elevation_many(comp, cx, cy, ct, co)
+    return out
 
 
 def kinematics(comp, depth: float, x, y, z, t):
     """(η, velocity (..., 3), acceleration (..., 3)) for arrays of x, y, z [m] (down) and t [s], broadcast.
 
     Velocity and acceleration are (north, east, down) [m/s, m/s²]; see :func:`kinematics_at`.
-    Raises ValueError for points below the bottom (z > depth).
+    Evaluated in compiled chunks (memory: the outputs plus O(CHUNK) buffers). Raises ValueError
+    for points below the bottom (z > depth).
     """
     comp = _check_components(comp)
-    b = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z, t)))
-    shape = b[0].shape
-    flat = [np.ascontiguousarray(v).ravel() for v in b]
-    if flat[2].size and np.max(flat[2]) > depth:
-        raise ValueError(f"points below the bottom: z up to {np.max(flat[2]):g} m > depth {depth:g} m")
-    out = np.empty((flat[0].size, 7))
-    _kinematics_many(comp, float(depth), flat[0], flat[1], flat[2], flat[3], out)
-    out = out.reshape(shape + (7,))
-    return out[..., 0], out[..., 1:4], out[..., 4:7]
+    if np.size(z) and float(np.max(z)) > depth:
+        raise ValueError(f"points below the bottom: z up to {float(np.max(z)):g} m > depth {depth:g} m")
+    shape = np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z), np.shape(t))
+    out = np.empty((7,) + shape)
+    for c in _chunks((x, y, z, t), tuple(out)):
+        _kinematics_many(comp, float(depth), *c)
+    return out[0], np.moveaxis(out[1:4], 0, -1), np.moveaxis(out[4:7], 0, -1)
 
 
 # =================================================================================================
@@ -587,7 +606,7 @@ class WaveSystem:
         return r1 * math.cos(self.direction_to), r1 * math.sin(self.direction_to)
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, eq=False)
 class WaveField:
     """A realized seaway: packed components and the definition truth scoring needs.
 
@@ -725,10 +744,14 @@ def realize(waves: Waves, depth_m: float, rng: np.random.Generator) -> WaveField
     """
     if not isinstance(rng, np.random.Generator):
         raise TypeError("rng must be a numpy.random.Generator (seeded for reproducibility)")
-    if not (isinstance(depth_m, (int, float)) and depth_m > 0.0):
+    try:
+        depth = float(depth_m)
+    except (TypeError, ValueError):
+        depth = math.nan
+    if not depth > 0.0:
         raise InputError("scenario", "environment.water_depth_m", f"{depth_m!r} is not allowed: expected a "
                          "depth > 0 m (math.inf for deep water)")
     systems = systems_of(waves)
-    parts = [realize_system(s, float(depth_m), rng) for s in systems]
+    parts = [realize_system(s, depth, rng) for s in systems]
     comp = np.concatenate(parts) if parts else np.zeros((0, NCOL))
-    return WaveField(np.ascontiguousarray(comp), float(depth_m), systems)
+    return WaveField(np.ascontiguousarray(comp), depth, systems)
