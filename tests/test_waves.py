@@ -229,6 +229,10 @@ def test_spectra_integrate_to_hs_and_peak_where_they_should():
                                rtol=1e-12)
     np.testing.assert_allclose(W.jonswap_spectrum(w, hs, 0.7, 1.0), W.bretschneider_spectrum(w, hs, 0.7),
                                rtol=1e-6)
+    # the scenario path (numerical moments of the shape) agrees with ITTC's closed forms
+    for kw, T in (("tz", 6.5), ("t1", 7.0)):
+        assert W.peak_frequency("pierson_moskowitz", **{kw: T}) == \
+            pytest.approx((0.8 * W.ittc_B(**{kw: T})) ** 0.25, rel=1e-9), kw
     # JONSWAP given T_z or T_1: the spectrum built has that period (quadrature)
     for kw, T in (("tz", 6.0), ("t1", 6.5)):
         wp = W.peak_frequency("jonswap", 3.3, **{kw: T})

@@ -81,8 +81,8 @@ so μ = direction_from + π (:func:`realize` converts explicitly).
 
 Components are packed as a float64 array (n, 6): [a, ω, k, cos μ, sin μ, ε] (COLUMNS below); the
 numba kernels :func:`elevation_at` and :func:`kinematics_at` evaluate one point, allocation free;
-:func:`elevation` and :func:`kinematics` do arrays of points/times in one compiled loop, with no
-(points × components) temporaries.
+:func:`elevation` and :func:`kinematics` do broadcast arrays of points/times in compiled chunks
+(numpy.nditer buffers of CHUNK points), with no (points × components) temporaries.
 
 The ``wavespectra`` library (PyPI, 4.9) was considered and not used: it requires xarray, dask,
 click, pyyaml, sortedcontainers and matplotlib at install (xarray is only a test extra here), its
