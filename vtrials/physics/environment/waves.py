@@ -392,7 +392,7 @@ def kinematics_at(comp, depth, x, y, z, t):
         st = math.sin(th)
         # depth factors F_c, F_s in the overflow-free form (module doc, section 5)
         e = math.exp(-k * z)
-        if deep:
+        if deep or k * (depth - z) > 19.0:  # e^{−2k(h−z)} < 3.2e−17: the finite-depth terms round away
             fc = e
             fs = e
         else:
