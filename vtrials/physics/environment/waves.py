@@ -300,20 +300,30 @@ def circular_spread(r1):
     return np.sqrt(2.0 * (1.0 - np.asarray(r1, dtype=float)))
 
 
-def _sample_spreading(kind: str, s: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Angles Δμ [rad] with D(Δμ; s_j) at quantiles q_j ∈ (0, 1) (inverse of the tabulated CDF)."""
+def _sample_spreading(kind: str, s: np.ndarray, q: np.ndarray, rows: int = 256) -> np.ndarray:
+    """Angles Δμ [rad] with density D(Δμ; s_j) at quantiles q_j ∈ (0, 1).
+
+    Inverts the CDF tabulated on _N_DIR_GRID nodes over (−π, π] (trapezoid rule, linear
+    interpolation between nodes), ``rows`` components at a time (bounded memory).
+    """
     if kind == "none":
         return np.zeros_like(q)
     grid = np.linspace(-math.pi, math.pi, _N_DIR_GRID)
-    out = np.empty_like(q)
+    h = grid[1] - grid[0]
     s = np.broadcast_to(np.asarray(s, dtype=float), q.shape)
-    keys = np.unique(s)
-    for sv in keys:
-        sel = s == sv
-        pdf = spreading_function(kind, grid, sv)
-        cdf = np.concatenate(([0.0], np.cumsum(0.5 * (pdf[1:] + pdf[:-1]) * np.diff(grid))))
-        cdf /= cdf[-1]
-        out[sel] = np.interp(q[sel], cdf, grid)
+    out = np.empty_like(q)
+    for i in range(0, q.size, rows):
+        sl = slice(i, i + rows)
+        qq = q[sl]
+        pdf = np.broadcast_to(spreading_function(kind, grid[None, :], s[sl, None]), (qq.size, grid.size))
+        cdf = np.zeros(pdf.shape)
+        np.cumsum(0.5 * h * (pdf[:, 1:] + pdf[:, :-1]), axis=1, out=cdf[:, 1:])
+        cdf /= cdf[:, -1:]
+        j = np.clip(np.sum(cdf < qq[:, None], axis=1), 1, grid.size - 1)  # cdf[j−1] < q ≤ cdf[j]
+        r = np.arange(qq.size)
+        c0, c1 = cdf[r, j - 1], cdf[r, j]
+        frac = np.where(c1 > c0, (qq - c0) / np.where(c1 > c0, c1 - c0, 1.0), 0.5)
+        out[sl] = grid[j - 1] + frac * h
     return out
 
 
