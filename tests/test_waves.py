@@ -19,7 +19,6 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq, least_squares
 from scipy.special import polygamma
-from scipy.stats import norm
 
 from vtrials.errors import InputError
 from vtrials.physics.environment import waves as W
