@@ -614,7 +614,10 @@ def compat_fit(imu: ImuRecord, observations: Mapping[str, Observation], free: Se
             converged = True
             break
 
-    sens = model.sensitivities(par, idx)
+    if not converged:
+        sens = model.sensitivities(par, idx)
+    # (when converged the last step was below tolerance × bound: the sensitivities of that iteration
+    # stand for the final point)
     m, _ = _information(sens, obs, res)
     cov_w = np.linalg.inv(m)
     cov_c, dof_c = _coloured_covariance(sens, obs, res, cov_w, refill)
