@@ -36,7 +36,7 @@ over the ground (inertial); a log measures speed through the water, so a current
 the "mean-zero sway" assumptions wrong — exactly the failure the seed suspected (its Table 6, §5.1).
 
 The fit (modified Newton–Raphson = Gauss–Newton with step halving) minimises
-J = ½ Σ_channels Σ_i ((y_i − ŷ_i)/σ)² with output sensitivities S from central finite differences.
+J = ½ Σ_channels Σ_i ((y_i − ŷ_i)/σ)² with output sensitivities S from forward finite differences.
 Bounds: ``"white"`` is the Cramér–Rao bound M⁻¹, M = Σ Sᵀ R⁻¹ S, with the stated σ — correct only
 when the residuals are white with that σ. Here they are not: the pseudo-observations (v ≈ 0, w ≈ 0,
 log = u, mean attitude) leave the wave-frequency motion in the residuals, a strongly coloured
@@ -73,7 +73,7 @@ PARAMETERS = ("b_p", "b_q", "b_r", "b_ax", "b_ay", "b_az",
               "k_p", "k_q", "k_r", "k_ax", "k_ay", "k_az",
               "roll0", "pitch0", "heading0", "u0", "v0", "w0", "north0", "east0", "down0")
 _INDEX = {n: i for i, n in enumerate(PARAMETERS)}
-# finite-difference steps (central), in each parameter's own unit
+# finite-difference steps, in each parameter's own unit
 _STEP = np.array([1e-6] * 3 + [1e-5] * 3 + [1e-6] * 6 + [1e-6] * 3 + [1e-5] * 3 + [1e-4] * 3)
 
 ATTITUDE_PARAMETERS = ("b_p", "b_q", "b_r", "roll0", "pitch0", "heading0")
@@ -424,21 +424,20 @@ class _Model:
         return x, _residual_blocks(x, self.obs)
 
     def sensitivities(self, par, idx):
-        """Output sensitivities ∂ŷ/∂θ per channel: channel → (n_rows, len(idx))."""
+        """Output sensitivities ∂ŷ/∂θ per channel (forward differences; the outputs are close to
+        linear in biases and initial states, steps in _STEP): channel → (n_rows, len(idx))."""
         sens = {name: [] for name in self.obs}
+        r0 = _residual_blocks(self.states(par), self.obs)
         for j in idx:
             h = _STEP[j]
             pp = par.copy()
-            pm = par.copy()
             pp[j] += h
-            pm[j] -= h
             rp = _residual_blocks(self.states(pp), self.obs)
-            rm = _residual_blocks(self.states(pm), self.obs)
             for name in self.obs:
-                d = rp[name] - rm[name]
+                d = rp[name] - r0[name]
                 if name == "heading":
                     d = _wrap(d)
-                sens[name].append(-d / (2 * h))  # residual = y − ŷ
+                sens[name].append(-d / h)  # residual = y − ŷ
         return {k: np.stack(v, axis=1) for k, v in sens.items()}
 
 
