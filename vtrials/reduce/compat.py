@@ -377,9 +377,13 @@ def _check_observations(observations: Mapping[str, Observation], n: int) -> dict
         if not (o.sigma > 0 and math.isfinite(o.sigma)):
             raise InputError(_WHERE, f"observations.{name}.sigma", f"value {o.sigma!r}; allowed: > 0")
         if o.average:
-            v = float(o.values)
+            try:
+                v = float(o.values)
+            except (TypeError, ValueError):
+                v = math.nan
             if not math.isfinite(v):
-                raise InputError(_WHERE, f"observations.{name}.values", f"value {o.values!r}; allowed: finite")
+                raise InputError(_WHERE, f"observations.{name}.values",
+                                 f"value {o.values!r}; allowed: one finite number (average=True)")
             obs[name] = (v, float(o.sigma), True)
         else:
             v = np.asarray(o.values, dtype=float)
