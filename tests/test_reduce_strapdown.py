@@ -80,7 +80,8 @@ def test_nonlinear_scheme_meets_miles_figure(rms_deg):
     lin = S.strapdown_linear(t, acc, arr, cutoff_hz=0.02)
     nre_lin = [S.nre(lin[:, i], euler[:, i]) for i in range(3)]
     nre_tr = [S.nre(res.displacement[:, i], x0[:, i]) for i in range(3)]
-    print(f"{rms_deg}° RMS: NRE roll/pitch/yaw {np.round(nre_ang, 3).tolist()} (linear {np.round(nre_lin, 2).tolist()}); "
+    print(f"{rms_deg}° RMS: NRE roll/pitch/yaw {np.round(nre_ang, 3).tolist()} "
+          f"(linear {np.round(nre_lin, 2).tolist()}); "
           f"surge/sway/heave {np.round(nre_tr, 2).tolist()}; iterations {res.iterations}; "
           f"mean roll/pitch {np.round(res.euler[:, :2].mean(0) / D, 3).tolist()}°")
     assert max(nre_ang) < 2.0

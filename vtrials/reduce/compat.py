@@ -153,7 +153,8 @@ class CompatResult:
 
     free: names of the estimated parameters (order of ``std``, ``covariance``, ``correlation``);
     parameters: every parameter's value (estimated or held); std: the chosen bound (1σ) per free
-    parameter; dof: Satterthwaite degrees of freedom of each coloured bound (∞ for white); bound_kind: ``"white"`` or ``"coloured"``; covariance / covariance_white /
+    parameter; dof: Satterthwaite degrees of freedom of each coloured bound (∞ for white);
+    bound_kind: ``"white"`` or ``"coloured"``; covariance / covariance_white /
     covariance_coloured; correlation; residuals: channel → y − ŷ; states (N, 9) in the order of
     ``STATES``; rates (N, 3) corrected p, q, r; acceleration (N, 3) corrected body acceleration of the
     centre of motion (gravity removed); iterations; cost J; converged.

@@ -167,8 +167,9 @@ def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: Accel
     rates of large oscillations have real content at difference frequencies below the wave band, so a
     lower rate cut-off is more accurate — but the fixed-point iteration of Euler's equations
     ω⁽ⁿ⁺¹⁾ = ∫(F − ω⁽ⁿ⁾ × ω⁽ⁿ⁾) has a gain of about 2|ω|/(2πf) at frequency f and diverges below
-    f ≈ |ω|/π; keep rate_cutoff_hz above that. point: body point Q [m] for the translations (default C). Converged when the largest change of ω (then of φ, θ) between iterations is below
-    ``tolerance`` (rad/s, rad).
+    f ≈ |ω|/π; keep rate_cutoff_hz above that. point: body point Q [m] for the translations
+    (default C). Converged when the largest change of ω, φ, θ and the mean attitude between iterations
+    is below ``tolerance`` (rad/s, rad).
     """
     t = np.asarray(time_s, float)
     a = np.asarray(accelerations, float)
