@@ -26,8 +26,9 @@ The nonlinear iterative scheme (Miles §3; steps 1 and 2 are iterated together):
 3. Surge, sway and heave (earth axes moving with the mean velocity) by double FFT integration of
    ẍ₀ = A f_C + g k₀ (or at any point Q: A(f_C + (Ω̇ + Ω²) ρ_Q) + g k₀).
 
-FFT integration treats the record as periodic; a record that is not should be tapered or cut at
-matching ends by the caller. The high-pass cut-off keeps low-frequency noise from being amplified (Miles:
+FFT integration treats the record as periodic (as Miles' random-phase simulations are); a record that
+is not should be cut at matching ends by the caller: on a record whose frequencies are off the record's
+own grid the measured NRE of roll/pitch/yaw was 4–9 % at 5° RMS and 7–11 % at 15° (vs < 2 % periodic). The high-pass cut-off keeps low-frequency noise from being amplified (Miles:
 "FC"); motion below it is lost — the method is for oscillatory motion, not for manoeuvres.
 
 Error metric (Miles eq. in §4): NRE = 100 · RMS(x_est − x_true) / (4 · RMS(x_true)) %.
@@ -92,6 +93,15 @@ def miles_array(roll_separation: float = 0.30, pitch_separation: float = 0.84,
     pos = [(hp, 0, 0), (-hp, 0, 0), (hy, 0, 0), (-hy, 0, 0), (0, -hr, 0), (0, hr, 0), (0, 0, 0)]
     ax = [(0, 0, 1), (0, 0, 1), (0, 1, 0), (0, 1, 0), (0, 0, 1), (0, 0, 1), (1, 0, 0)]
     return AccelerometerArray(np.array(pos, float), np.array(ax, float))
+
+
+def triaxial_array(positions) -> AccelerometerArray:
+    """Tri-axial accelerometers at the given body positions (k, 3) [m]: three sensors (x, y, z) each.
+    Three units at non-collinear points observe f_C and ω̇."""
+    p = np.asarray(positions, float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise InputError(_WHERE, "positions", f"shape {p.shape}; allowed: (k, 3) [m]")
+    return AccelerometerArray(np.repeat(p, 3, axis=0), np.tile(np.eye(3), (p.shape[0], 1)))
 
 
 def nre(estimate: np.ndarray, truth: np.ndarray) -> float:
