@@ -1,4 +1,4 @@
-"""vtrials.steadyturn — the steady-turning curve (spiral-trial truth) against plain time simulation.
+"""vtrials.truth.steadyturn — the steady-turning curve (spiral-trial truth) against plain time simulation.
 
 The curve is solved from the simulator's accelerations (no time stepping); the checks here run the
 simulator forward with the rudder held (Dieudonné 1953 direct-spiral style holds; ITTC 7.5-04-02-01)

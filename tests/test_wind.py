@@ -1,4 +1,4 @@
-"""Wind model (vtrials.wind): gust spectra, gust synthesis, Isherwood wind loads, the numba kernel.
+"""Wind model (vtrials.physics.environment.wind): gust spectra, gust synthesis, Isherwood wind loads, the numba kernel.
 
 References used by the checks (independent of the module's own code paths):
 * closed-form spectrum variances via Gamma functions (Harris, NPD) and Davenport's σ² = 6κU₁₀²

@@ -5,11 +5,11 @@ every field):
 
 ``[scenario]``      title, ship (a folder under models/), seed, timestep_s, planar, record_every
 ``[initial]``       exactly one of froude_number / speed_kn / speed_mps; heading_deg; propulsion
-``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.sea.Current`)
+``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.physics.environment.current.Current`)
 ``[[maneuver]]``    one table per maneuver, with ``kind`` and that kind's fields
-                    (:mod:`vtrials.maneuvers`), run side by side, one ship each
+                    (:mod:`vtrials.trials.programs`), run side by side, one ship each
 ``[agenda]``        instead of maneuvers: a trial agenda executed run by run on one ship by the virtual
-                    crew (:mod:`vtrials.agenda`, :mod:`vtrials.crew`); ``[initial]`` is then optional
+                    crew (:mod:`vtrials.trials.agenda`, :mod:`vtrials.trials.crew`); ``[initial]`` is then optional
                     (default: steady at the first run's setting, on its course)
 ``[site]``, ``[[instrument]]``  the trial site as surveyed; additions/overrides of the ship's suite
 
@@ -105,7 +105,7 @@ class Scenario:
     vessel: Vessel
     site: dict = dataclasses.field(default_factory=dict)
     instrument_items: list = dataclasses.field(default_factory=list)
-    agenda: object = None  # vtrials.agenda.Agenda when the scenario is an agenda
+    agenda: object = None  # vtrials.trials.agenda.Agenda when the scenario is an agenda
 
     @property
     def speed(self) -> float:

@@ -2,7 +2,7 @@
 chain of error parts from its catalogue entry.
 
 Every device works on truth chunks (dicts of equal-length arrays at the simulation rate, as
-:func:`vtrials.truth.ship_columns` gives them), streaming: ``reset(rng)`` then ``process(cols)``
+:func:`vtrials.truth.columns.ship_columns` gives them), streaming: ``reset(rng)`` then ``process(cols)``
 any number of times; it returns the samples it emits per channel, in SI units, on its own clock.
 ``drawn()`` lists the error parameters actually drawn (for the truth file); ``meta()`` what the
 trials team knows (nominal calibration, surveyed position, rate) — the record carries it.

@@ -111,7 +111,7 @@ def record_width(n_rudders: int, n_shafts: int, n_components: int) -> int:
 
 
 def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[str]:
-    """Column names of the truth record, in the kernel's order (units in :mod:`vtrials.truth`)."""
+    """Column names of the truth record, in the kernel's order (units in :mod:`vtrials.truth.columns`)."""
     names = ["t", "x", "y", "z", "qw", "qx", "qy", "qz", "roll", "pitch", "heading",
              "u", "v", "w", "p", "q", "r", "u_r", "v_r", "w_r",
              "du", "dv", "dw", "dp", "dq", "dr", "current_n", "current_e", "drift_n", "drift_e",

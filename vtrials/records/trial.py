@@ -34,7 +34,7 @@ def _json_attr(v):
 
 def record_groups(iset, t_end: float, events: list[tuple[float, int, int]],
                   orders: list[tuple[float, str]], t_start: float = -np.inf, settings=None) -> dict:
-    """Groups for :func:`vtrials.records.write_groups` from an instrument set's readings.
+    """Groups for :func:`vtrials.records.netcdf.write_groups` from an instrument set's readings.
 
     Only samples stamped in [t_start, t_end] (the span of the recording) are kept. ``settings``:
     (t, shaft, rps order, pitch order, mode code) rows of the engine-room log, written as ``_settings``.

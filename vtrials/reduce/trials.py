@@ -1,7 +1,7 @@
 """Reducing a trial record: what the trials team does with the data of a standardization or a
 speed-log calibration trial, from the record file alone.
 
-Inputs (all from :class:`vtrials.records.Record`): the instrument groups (found by their ``kind``, not
+Inputs (all from :class:`vtrials.records.netcdf.Record`): the instrument groups (found by their ``kind``, not
 their names), the director's log sheet (``run_log``: run numbers, courses, settings, COMEX / EXECUTE /
 FINEX times, accepted runs), the team's knowledge (ship particulars, windage coefficients, surveyed
 sensor positions, nominal calibrations) and the tank prediction in the record's attributes.

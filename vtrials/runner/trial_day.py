@@ -4,10 +4,10 @@ The flow of one trial day (architecture.md):
 
 1. :func:`simulate_agenda` — one ship, the virtual crew executes every run; instruments stream the
    truth; per-run truth references are taken at each FINEX; the calm-water truth at every setting the
-   crew used is computed by :mod:`vtrials.calmwater`.
+   crew used is computed by :mod:`vtrials.truth.calmwater`.
 2. :func:`write_agenda_outputs` — ``truth.nc`` (state history, drawn instrument errors, per-run truth
    references), ``records/<trial>.nc`` (what the team has), then the reductions — which read the
-   record FILES just written, through :mod:`vtrials.records`, never the in-memory truth — then the
+   record FILES just written, through :mod:`vtrials.records.netcdf`, never the in-memory truth — then the
    scoring against truth, ``results.json`` (a ``trials`` list with ``reduced``, ``truth`` and
    ``error`` per trial) and ``report.md`` with PNG figures.
 """
@@ -146,7 +146,7 @@ def calm_water_truth(scn: Scenario, crew: Crew) -> dict:
 
 def spiral_truth(scn: Scenario, crew: Crew) -> dict:
     """For every spiral run: the steady-turning curve δ(r) of the model's own equations at the run's
-    shaft settings (calm deep water) and its hysteresis loop (:mod:`vtrials.steadyturn`)."""
+    shaft settings (calm deep water) and its hysteresis loop (:mod:`vtrials.truth.steadyturn`)."""
     from vtrials.truth.steadyturn import hysteresis, steady_turning_curve
     out = {}
     cache = {}

@@ -4,11 +4,11 @@ definition, with the error and whether the reduced 95 % interval covers the trut
 Truth references (never the reduction run on cleaner data):
 
 * a run's speed through water, ground speed, current, power: means over its window [EXECUTE, FINEX]
-  of the true state (:func:`vtrials.crew.window_truth`);
+  of the true state (:func:`vtrials.trials.crew.window_truth`);
 * a spot's speed through water: the heading-balanced mean ½(mean over the base-course runs + mean
   over the reciprocal runs) — the quantity current elimination estimates;
 * the speed–power curve: the calm-water steady states at the shaft settings the crew used
-  (:mod:`vtrials.calmwater`), interpolated monotonically in log–log between the settings and their
+  (:mod:`vtrials.truth.calmwater`), interpolated monotonically in log–log between the settings and their
   midpoints;
 * a log calibration: the knotmeter's own drawn calibration (:meth:`Knotmeter.true_calibration`).
 """

@@ -2,7 +2,7 @@
 
 An agenda names the general rules of the day (base course, the helmsman's rudder limit on a run,
 approach and settling times, how steadiness is judged, whether unsteady runs are repeated) and a list
-of trials. Each trial expands into numbered runs that the virtual crew (:mod:`vtrials.crew`) executes
+of trials. Each trial expands into numbered runs that the virtual crew (:mod:`vtrials.trials.crew`) executes
 one after another on one ship:
 
 ``[[agenda.trial]] kind = "standardization"``

@@ -59,7 +59,7 @@ def judge(display: dict, course: float | None, st, modes: tuple, torque_floor: f
 
     ``display``: {"rps": [(t, x) per shaft or None], "torque": [(t, x) per shaft or None],
     "heading": (t, ψ) or None, "log": (t, speed) or None}; ``course`` [rad]; ``st`` the agenda's
-    :class:`~vtrials.agenda.Steadiness` (``course`` None: heading not judged, e.g. stopped or astern);
+    :class:`~vtrials.trials.agenda.Steadiness` (``course`` None: heading not judged, e.g. stopped or astern);
     ``modes`` per shaft; ``torque_floor`` [N m]: the torque tolerance is relative to at least this
     (a shaft at zero pitch carries almost no torque). Returns (steady, reasons it is not). Shafts that
     are locked are not judged; a trailing shaft's torque is not judged.
@@ -175,7 +175,7 @@ def window_truth(cols: dict, t0: float, t1: float) -> dict:
 
 # ----------------------------------------------------------------------------------- the crew
 class Crew:
-    """Runs an :class:`~vtrials.agenda.Agenda` on ship 0 of a one-ship :class:`Simulator`.
+    """Runs an :class:`~vtrials.trials.agenda.Agenda` on ship 0 of a one-ship :class:`Simulator`.
 
     ``iset``: the ship's :class:`~vtrials.instruments.suite.InstrumentSet` (reset by the caller);
     ``truth_every``: keep every k-th truth row for the truth file (instruments see every row);

@@ -209,7 +209,7 @@ def execute(crew, run: Run, att) -> None:
 
 def maneuver_truth(run: Run, att, cols: dict) -> dict:
     """Truth references of a maneuvering run from the true state (EXECUTE to FINEX, track through the
-    water), by the definitions of :mod:`vtrials.truth_metrics`; spirals: the true mean rate of turn and
+    water), by the definitions of :mod:`vtrials.truth.metrics`; spirals: the true mean rate of turn and
     rudder over each setting's data window."""
     p = run.params
     t = cols["t"]

@@ -92,7 +92,7 @@ angles in rad. Knots and degrees appear only in names that say so (the scenario 
    car carriers it extrapolates.
 
 5. Kernel. ``wind_kernel(p, s, env, ctx, aux, w)`` follows the force-component interface of
-   :mod:`vtrials.forces.layout`. The wind description lives in the environment block at the
+   :mod:`vtrials.physics.forces.context`. The wind description lives in the environment block at the
    ``E_WIND_*`` indices (16…20) and the gust components from ``E_GUST`` (64) on; the ship's
    windage in ``p`` (:func:`pack_wind`). True wind velocity (world, north-east-down) =
    −U(t)·(cos β_w, sin β_w, 0), β_w the direction it blows FROM; U(t) = U₁₀ (z_ref/10)^α + u'(t)
@@ -130,7 +130,7 @@ KAPPA_SEA = 0.0025  # surface drag coefficient over sea (docs/environment.md; Ha
 HARRIS_L = 1800.0  # [m] Harris (1971) length scale
 DAVENPORT_L = 1200.0  # [m] Davenport (1961) length scale
 
-# --- environment block (per ship), after the current's 0..15 (see vtrials.sea) ------------------
+# --- environment block (per ship), after the current's 0..15 (see vtrials.physics.environment.current) ------------------
 E_WIND_U10 = 16  # mean wind speed at 10 m [m/s]
 E_WIND_DIR = 17  # direction the wind blows FROM [rad], north = 0, clockwise
 E_WIND_ALPHA = 18  # power-law exponent of the mean profile [–]
@@ -491,7 +491,7 @@ def pack_wind(params: Windage, rho_air: float = RHO_AIR) -> np.ndarray:
 def pack_wind_env(base_env: np.ndarray, U10: float, direction_from: float,
                   exponent: float = ISO15016_EXPONENT, z_ref: float = Z_REF_10,
                   gusts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> np.ndarray:
-    """A copy of ``base_env`` (e.g. :func:`vtrials.sea.pack`) with the wind written in (SI).
+    """A copy of ``base_env`` (e.g. :func:`vtrials.physics.environment.current.pack`) with the wind written in (SI).
 
     The result is widened to :func:`env_width` (n_g) when the gusts need more room; gust
     components are ``(amp, omega, phase)`` as returned by :func:`gust_components`, generated for

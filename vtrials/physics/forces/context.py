@@ -5,7 +5,7 @@ Every force component is a numba kernel ``kernel(p, s, env, ctx, aux, w)`` (see
 
 * ``p``   – the component's own parameter block (float64, packed by its ``pack`` function),
 * ``s``   – the component's own internal states (advanced by the kernel over one step ``ctx[DT]``),
-* ``env`` – the ship's environment block (current, later wind and waves), see :mod:`vtrials.sea`,
+* ``env`` – the ship's environment block (current, later wind and waves), see :mod:`vtrials.physics.environment.current`,
 * ``ctx`` – the kinematic context below (read only),
 * ``aux`` – per-propeller / per-rudder outputs, written by propellers and read by rudders,
 * ``w``   – the component's wrench, body frame at the origin (midship, waterline):

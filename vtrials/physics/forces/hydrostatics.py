@@ -16,7 +16,7 @@ buoyancy B (x_G, 0, d − KB). With the added-mass term of the dynamics it makes
 thrust move with the water, as it must.
 
 Damping: linear in the heave, roll and pitch velocities relative to the water, B_ii set from
-damping ratios of the uncoupled modes (see :mod:`vtrials.vessel`), plus an optional quadratic roll
+damping ratios of the uncoupled modes (see :mod:`vtrials.physics.vessel`), plus an optional quadratic roll
 term B_44q |p| p.
 """
 
