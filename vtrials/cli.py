@@ -61,6 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "maneuvers, with the true motion recorded and every result scored against it.",
         epilog="Commands:\n  run      simulate a scenario file and write truth, records, results and plots\n"
                "  inspect  list a trial record's channels, rates and units; plot chosen channels\n"
+               "  campaign run many randomized replicates of an agenda; coverage and sharpness of every interval\n"
                "  models   list the vessel models\n\nSee 'vtrials run --help' for the scenario format.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"vtrials {__version__}")
@@ -85,7 +86,57 @@ def build_parser() -> argparse.ArgumentParser:
     ins.add_argument("record", metavar="RECORD", help="trial record file (records/*.nc written by 'vtrials run')")
     ins.add_argument("--plot", nargs="+", metavar="INSTRUMENT/CHANNEL", help="channels to plot")
     ins.add_argument("--out", metavar="PNG", help="where to write the plot (default: RECORD with .png)")
+    c = sub.add_parser("campaign", help="run many randomized replicates of an agenda and measure interval coverage",
+                       description="Run N replicates of an agenda scenario (each with its own draws of the "
+                                   "scenario's [campaign.vary] fields and its own seed), reduce and score every "
+                                   "replicate, and write campaign.parquet (one row per replicate and reduced "
+                                   "quantity), summary.parquet and summary.json (coverage with its Wilson interval, "
+                                   "sharpness and verdict per quantity) to DIR.",
+                       epilog="[campaign] table of the scenario: replicates, seed, and [campaign.vary] with "
+                              "'dotted.path' = { uniform = [lo, hi] } | { normal = [mean, sd], min, max } | "
+                              "{ choice = [...] }. Results do not depend on worker count or executor.")
+    c.add_argument("scenario", metavar="SCENARIO", help="agenda scenario file (TOML), with an optional [campaign]")
+    c.add_argument("--out", metavar="DIR", required=True, help="output directory")
+    c.add_argument("--replicates", type=int, metavar="N", help="number of replicates (default: [campaign] replicates)")
+    c.add_argument("--seed", type=int, metavar="S", help="campaign seed (default: [campaign] seed)")
+    c.add_argument("--executor", choices=("process", "dask"), default="process",
+                   help="process: a local spawn process pool (default); dask: a Dask distributed cluster")
+    c.add_argument("--address", metavar="ADDRESS", help="Dask scheduler address (with --executor dask; default: "
+                                                        "a local cluster)")
+    c.add_argument("--workers", type=int, metavar="K", help="worker processes (process pool; default: CPU count)")
+    c.add_argument("--resume", action="store_true", help="continue a campaign killed before it finished")
+    c.add_argument("--records", action="store_true", help="keep every replicate's records and truth")
+    c.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
+
+
+def _campaign(args) -> int:
+    from vtrials.campaign.run import run_campaign
+    for name, v, lo in (("--replicates", args.replicates, 1), ("--workers", args.workers, 1), ("--seed", args.seed, 0)):
+        if v is not None and v < lo:
+            raise InputError(name, "", f"must be at least {lo}")
+    executor, client = None, None
+    if args.executor == "dask":
+        try:
+            from distributed import Client
+        except ImportError:
+            raise InputError("--executor", "dask", "needs the dask extra: pip install 'vtrials[dask]'") from None
+        client = Client(args.address) if args.address else Client(n_workers=args.workers or None)
+        executor = client.get_executor()
+    try:
+        doc = run_campaign(args.scenario, args.out, replicates=args.replicates, seed=args.seed, executor=executor,
+                           workers=args.workers, resume=args.resume, keep_records=args.records,
+                           progress=not args.quiet)
+    finally:
+        if client is not None:
+            client.close()
+    if not args.quiet:
+        print(f"{'quantity':<56} {'n':>5} {'coverage':>9} {'Wilson 95 %':>15} {'sharpness':>9}  verdict")
+        for q in doc["quantities"]:
+            print(f"{q['group']:<56} {q['n']:>5} {q['coverage']:>9.3f} "
+                  f"[{q['wilson_lo']:.3f}, {q['wilson_hi']:.3f}] {q['sharpness']:>9.2f}  {q['verdict']}")
+        print(f"wrote {args.out}/campaign.parquet, summary.parquet, summary.json")
+    return 0
 
 
 def _inspect(args) -> int:
@@ -191,6 +242,8 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "inspect":
             return _inspect(args)
+        if args.command == "campaign":
+            return _campaign(args)
     except SimulationError as exc:
         print(f"vtrials: simulation stopped: {exc}", file=sys.stderr)
         return 3

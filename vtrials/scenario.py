@@ -124,14 +124,16 @@ class Scenario:
         return self.initial.heading_deg * DEG
 
 
-_TOP = ("scenario", "initial", "environment", "maneuver", "agenda", "site", "instrument")
+_TOP = ("scenario", "initial", "environment", "maneuver", "agenda", "site", "instrument", "campaign")
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and check a scenario file (and the vessel it names)."""
+def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
+    """Read and check a scenario file (and the vessel it names). ``doc``: the file's tables already
+    read (and changed, e.g. by a campaign's draws); ``path`` then names it in messages and anchors
+    relative paths. A ``[campaign]`` table is read by :mod:`vtrials.campaign` and ignored here."""
     p = Path(path)
     f = str(path)
-    doc = load_toml(p)
+    doc = load_toml(p) if doc is None else doc
     for key in doc:
         if key not in _TOP:
             raise unknown_key(f, "", key, list(_TOP))

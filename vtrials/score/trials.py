@@ -26,13 +26,15 @@ from vtrials.units import KNOT
 
 
 def _cmp(reduced: dict | None, truth: float, scale: float = 1.0) -> dict:
-    """Error (reduced − truth) and coverage of the truth by the reduced 95 % interval."""
+    """Error (reduced − truth) / scale, the reduced 95 % interval and whether it covers the truth."""
     if reduced is None or truth is None or not math.isfinite(truth):
         return {"truth": truth, "reduced": None if reduced is None else reduced.get("value"), "error": None,
                 "covered": None}
     e = Estimate(reduced["value"], reduced["std"], reduced.get("dof"))
-    return {"truth": truth, "reduced": e.value, "std": e.std, "error": (e.value - truth) / scale,
-            "covered": bool(e.covers(truth)) if math.isfinite(e.std) else None}
+    lo, hi = e.interval()
+    # half_width95 is in the units of "error" (divided by ``scale`` like it) for campaign sharpness
+    return {"truth": truth, "reduced": e.value, "std": e.std, "lo95": lo, "hi95": hi,
+            "half_width95": 0.5 * (hi - lo) / scale, "error": (e.value - truth) / scale, "covered": bool(e.covers(truth)) if math.isfinite(e.std) else None}
 
 
 def _truth_of(crew, trial: str) -> dict:

@@ -1,0 +1,133 @@
+"""Campaigns: reproducible draws, the same table whatever runs it, resume after a kill, and the
+coverage statistics checked on analytic cases."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vtrials.campaign.run import run_campaign
+from vtrials.campaign.spec import load_campaign, replicate_doc, replicate_seeds
+from vtrials.errors import InputError
+from vtrials.score.coverage import sharpness, verdict, wilson
+
+SCN = Path(__file__).resolve().parent / "data" / "campaign_logcal.toml"
+
+
+def test_wilson_interval_against_a_hand_computation():
+    # k = 95, n = 100: p = 0.95, z = 1.96 → (0.9513 ± 0.0442) / 1.0384
+    lo, hi = wilson(95, 100)
+    assert lo == pytest.approx(0.88825, abs=2e-4) and hi == pytest.approx(0.97846, abs=2e-4)
+    assert wilson(0, 10)[0] == pytest.approx(0.0, abs=1e-12) and wilson(10, 10)[1] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_sharpness_and_verdict_on_honest_and_dishonest_intervals():
+    rng = np.random.default_rng(3)
+    sd = 0.2
+    err = rng.normal(0.0, sd, 4000)
+    hw = np.full(err.size, 1.96 * sd)
+    covered = np.abs(err) <= hw
+    assert sharpness(hw, err) == pytest.approx(1.0, abs=0.05)
+    assert verdict(covered, hw, err)["verdict"] == "calibrated"
+    wide = verdict(np.ones(err.size, bool), 100 * hw, err)  # covers always, 100× too wide
+    assert wide["verdict"] == "uncalibrated" and "sharpness" in wide["why"]
+    narrow = np.abs(err) <= hw / 3
+    v = verdict(narrow, hw / 3, err)
+    assert v["verdict"] == "uncalibrated" and "coverage" in v["why"]
+
+
+def test_draws_are_reproducible_and_per_replicate():
+    spec = load_campaign(str(SCN))
+    seeds = replicate_seeds(spec.seed, 3)
+    a = [replicate_doc(spec, s)[1] for s in seeds]
+    b = [replicate_doc(spec, s)[1] for s in replicate_seeds(spec.seed, 3)]
+    assert a == b
+    assert len({d["scenario.seed"] for d in a}) == 3
+    assert len({d["environment.current.direction_deg"] for d in a}) == 3
+    assert all(d["environment.wind.speed_kn"] >= 0.0 for d in a)
+    # replicate i's draws do not depend on how many replicates there are
+    assert replicate_doc(spec, replicate_seeds(spec.seed, 10)[1])[1] == a[1]
+
+
+@pytest.mark.parametrize("vary, field, what", [
+    ('"environment.nothing.x" = { uniform = [0, 1] }', "campaign.vary.environment.nothing.x", "no environment.nothing"),
+    ('"environment.wind.speed_kn" = { uniform = [2, 1] }', "campaign.vary.environment.wind.speed_kn.uniform", "lower"),
+    ('"environment.wind.speed_kn" = { gauss = [2, 1] }', "campaign.vary.environment.wind.speed_kn", "exactly one"),
+    ('"agenda.trial[7].run_s" = { uniform = [60, 90] }', "campaign.vary.agenda.trial[7].run_s", "no element 7"),
+])
+def test_bad_campaign_tables_are_clear_errors(tmp_path, vary, field, what):
+    text = SCN.read_text().split("[campaign.vary]")[0] + "[campaign.vary]\n" + vary + "\n"
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(InputError) as e:
+        load_campaign(str(p))
+    assert e.value.field == field and what in str(e.value)
+
+
+def _table(out: Path):
+    import pyarrow.parquet as pq
+    return pq.read_table(out / "campaign.parquet")
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    out = tmp_path_factory.mktemp("camp") / "serial"
+    doc = run_campaign(SCN, out, workers=1)
+    return out, doc
+
+
+def test_campaign_scores_every_replicate(serial):
+    out, doc = serial
+    t = _table(out).to_pydict()
+    assert sorted(set(t["replicate"])) == [0, 1, 2]
+    groups = {q["group"]: q for q in doc["quantities"]}
+    assert "log_calibration/legs[]/stw" in groups
+    stw = groups["log_calibration/legs[]/stw"]
+    assert stw["n"] == 3 * 8  # 8 legs per replicate
+    # errors are real numbers of the right size (kn-level trials: well under a knot)
+    err = np.array([e for g, e in zip(t["group"], t["error"]) if g == "log_calibration/legs[]/stw"])
+    assert np.all(np.isfinite(err)) and np.max(np.abs(err)) < 0.5
+    assert len(doc["draws"]) == 3
+
+
+def test_same_table_with_two_workers_and_with_dask(serial, tmp_path):
+    out, _ = serial
+    ref = _table(out)
+    run_campaign(SCN, tmp_path / "two", workers=2)
+    assert _table(tmp_path / "two").equals(ref)
+    from distributed import Client, LocalCluster
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        run_campaign(SCN, tmp_path / "dask", executor=client.get_executor())
+    assert _table(tmp_path / "dask").equals(ref)
+
+
+def test_resume_after_a_kill_gives_the_same_table(serial, tmp_path):
+    out, _ = serial
+    part = tmp_path / "part"
+    shutil.copytree(out, part)
+    (part / "parts" / "replicate_00001.json").unlink()  # as if killed before replicate 1 finished
+    (part / "campaign.parquet").unlink()
+    with pytest.raises(InputError, match="--resume"):
+        run_campaign(SCN, part, workers=1)
+    run_campaign(SCN, part, workers=1, resume=True)
+    assert _table(part).equals(_table(out))
+    with pytest.raises(InputError, match="campaign there was"):
+        run_campaign(SCN, part, replicates=5, workers=1, resume=True)
+
+
+def test_coverage_summary_is_consistent_with_the_rows(serial):
+    out, doc = serial
+    t = _table(out).to_pydict()
+    for q in doc["quantities"]:
+        rows = [i for i, g in enumerate(t["group"]) if g == q["group"]]
+        assert q["n"] == len(rows)
+        assert q["covered"] == sum(t["covered"][i] for i in rows)
+        for i in rows:  # the interval and the coverage flag agree
+            inside = t["lo95"][i] <= t["truth"][i] <= t["hi95"][i]
+            assert inside == t["covered"][i] or math.isclose(t["lo95"][i], t["truth"][i]) or \
+                math.isclose(t["hi95"][i], t["truth"][i])
