@@ -240,13 +240,17 @@ def _section_points(b, T, n, m):
     return np.interp(target, arc, y), np.interp(target, arc, z)
 
 
-def station_positions(n_stations: int, hp: HullParticulars):
-    """ξ of the stations: cosine-clustered towards both ends, midship (ξ = 0) always a station."""
+def station_positions(n_stations: int, cluster: float = 0.5):
+    """ξ of the stations: half uniform, half sine-clustered towards both ends (``cluster`` = weight of the
+    sine mapping), midship (ξ = 0) always a station."""
     half_f = n_stations // 2
     half_a = n_stations - half_f
-    fwd = np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, half_f + 1))
-    aft = -np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, half_a + 1))[::-1]
-    return np.concatenate([aft[:-1], fwd])
+
+    def one_side(n):
+        u = np.linspace(0.0, 1.0, n + 1)
+        return (1.0 - cluster) * u + cluster * np.sin(0.5 * np.pi * u)
+
+    return np.concatenate([-one_side(half_a)[::-1][:-1], one_side(half_f)])
 
 
 def hull_mesh(form: HullForm, n_stations: int = 40, n_girth: int = 12) -> HullMesh:
@@ -258,7 +262,7 @@ def hull_mesh(form: HullForm, n_stations: int = 40, n_girth: int = 12) -> HullMe
     if n_stations < 6 or n_girth < 3:
         raise InputError("hull mesh", "n_stations/n_girth", f"need ≥ 6 and ≥ 3, got {n_stations}, {n_girth}")
     hp = form.particulars
-    xi = station_positions(n_stations, hp)
+    xi = station_positions(n_stations)
     x = 0.5 * hp.length * xi
     b, _, n = offsets(form, xi)
     m = n_girth
@@ -277,13 +281,20 @@ def hull_mesh(form: HullForm, n_stations: int = 40, n_girth: int = 12) -> HullMe
             faces.append([idx[i, j], idx[i, j + 1], idx[i + 1, j + 1], idx[i + 1, j]])
     V = verts.reshape(-1, 3)
     if hp.transom > 0.0:
-        # flat transom face at the aft end: strips between the section curve and the centreline
+        # flat transom face at the aft end: each strip between the section curve and the centreline
+        # cut into columns about as wide as the girth spacing (quads from the curve inwards)
         y0, z0 = verts[0, :, 1], verts[0, :, 2]
+        girth = float(np.sum(np.hypot(np.diff(y0), np.diff(z0)))) / m
+        n_col = max(1, int(math.ceil(float(y0[0]) / girth)))
+        frac = np.linspace(1.0, 0.0, n_col + 1)[1:]            # inner columns, towards the centreline
         base = V.shape[0]
-        cl = np.column_stack([np.full(m + 1, x[0]), np.zeros(m + 1), z0])
-        V = np.vstack([V, cl])
-        for j in range(m):
-            faces.append([idx[0, j], base + j, base + j + 1, idx[0, j + 1]])   # normal aft
+        inner = np.stack([np.column_stack([np.full(m + 1, x[0]), f * y0, z0]) for f in frac])  # (n_col, m+1, 3)
+        V = np.vstack([V, inner.reshape(-1, 3)])
+        col = [idx[0]] + [base + c * (m + 1) + np.arange(m + 1) for c in range(n_col)]
+        for c in range(n_col):
+            a, b = col[c], col[c + 1]
+            for j in range(m):
+                faces.append([a[j], b[j], b[j + 1], a[j + 1]])   # normal aft
     F = np.asarray(faces, dtype=np.int64)
     mesh = HullMesh(V, F)
     return _drop_degenerate(mesh)
