@@ -249,12 +249,13 @@ def _drift(setup: ShipSetup, ds, A_c, B_c, C_c, X_c):
     sub = xr.Dataset({"kochin_diffraction": _drop_scalar_dims(ds["kochin_diffraction"]),
                       "kochin_radiation": _drop_scalar_dims(ds["kochin_radiation"])})
     sub = sub.assign(wavenumber=("omega", omega ** 2 / setup.g), water_depth=np.inf, rho=setup.rho, g=setup.g)
-    res = far_field_mean_drift_force(X, sub)
     nb = X.sizes["wave_direction"]
     out = np.zeros((omega.size, nb, 3))
-    for j, name in enumerate(("drift_force_surge", "drift_force_sway", "drift_force_yaw")):
-        d = res[name].values   # (omega, k, l)
-        out[:, :, j] = np.real(d[:, np.arange(nb), np.arange(nb)]) * DRIFT_SIGN[j]
+    for i in range(nb):   # one direction at a time: only the unidirectional (diagonal) terms are needed
+        bi = X["wave_direction"].values[i:i + 1]
+        res = far_field_mean_drift_force(X.sel(wave_direction=bi), sub.sel(wave_direction=bi))
+        for j, name in enumerate(("drift_force_surge", "drift_force_sway", "drift_force_yaw")):
+            out[:, i, j] = np.real(res[name].values[:, 0, 0]) * DRIFT_SIGN[j]
     return out, float(Bv[3, 3])
 
 
@@ -384,7 +385,7 @@ def _readme(setup: ShipSetup, hyd: dict, levels: list, changes: list, attrs: dic
               "Froude–Krylov + diffraction (both stored too).",
               "* Mean drift: per unit amplitude squared, far-field (Maruo/Kochin, Capytaine's implementation), "
               "with the RAO of the free ship using `rigid_body_mass` and a linear viscous roll damping "
-              f"B44 = {attrs['drift_roll_damping']:.4g} N m s.",
+              f"B44 = {float(attrs['drift_roll_damping']):.4g} N m s.",
               f"* ρ = {setup.rho} kg/m³, g = {setup.g} m/s², deep water, zero forward speed.",
               "",
               "## Limits", "",
@@ -394,9 +395,36 @@ def _readme(setup: ShipSetup, hyd: dict, levels: list, changes: list, attrs: dic
               "high-frequency tail of B(ω) beyond that.",
               f"* Irregular frequencies are removed with a lid at z = −{LID_DEPTH} T inside the hull.",
               "* The parametric hull reproduces the particulars above, not the real lines; local quantities "
-              "(pressure, sectional loads) are not representative.", ""]
+              "(pressure, sectional loads) are not representative.",
+              "* Capytaine warns where the largest panel exceeds 1/8 of the wavelength; the mesh levels in "
+              "`hull.toml` were chosen so that the shipped level stays below it over the stored range "
+              "(the lid's panels may exceed it slightly at the top frequency).", "",
+              "## Checks", "",
+              "`tests/test_hydro_database.py` (no Capytaine needed): hull particulars from the mesh; "
+              "symmetry of A and B and no symmetric/antisymmetric mode coupling; B ≥ 0; B decaying and "
+              "A → A∞ over the top of the range; stiffness vs an independent mesh integration and vs "
+              "ship.toml; long-wave limits of the excitation; Haskind's relation for all six dofs; "
+              "Kramers–Kronig between A and B; drift signs, symmetry and the short-wave beam-sea limit; "
+              "the convergence figures above.", ""]
     lines += checks.get("extra", [])
     return "\n".join(lines)
+
+
+def write_readme(setup: ShipSetup, nc_path: Path) -> Path:
+    """(Re)write ``README.md`` next to a database from the file itself (no BEM needed)."""
+    from .database import load_database
+
+    db = load_database(nc_path)
+    ns, ng = json.loads(db.attrs["mesh_stations_girth"])
+    mesh = hf.hull_mesh(hf.fit_hullform(setup.particulars), ns, ng)
+    hyd = hf.mesh_hydrostatics(mesh)
+    hyd["A_M"] = hf.mesh_section_area(mesh, 0.0)
+    conv = json.loads(db.attrs["convergence"])
+    text = _readme(setup, hyd, conv["levels"], conv["relative_changes"], db.attrs, db.C,
+                   {"hydrostatics_note": db.attrs["hydrostatics_note"]})
+    path = nc_path.parent / "README.md"
+    path.write_text(text)
+    return path
 
 
 def build(ship: str, models_dir: Path = MODELS_DIR, n_threads: int = 2, levels: str = "all") -> Path:
@@ -483,7 +511,7 @@ def build(ship: str, models_dir: Path = MODELS_DIR, n_threads: int = 2, levels: 
     }
     out = models_dir / setup.name / "hydro" / f"{setup.name}_hydro.nc"
     write_database(out, setup, finest, attrs)
-    (out.parent / "README.md").write_text(_readme(setup, hyd, records, changes, attrs, C, {"hydrostatics_note": note}))
+    write_readme(setup, out)
     print(f"{ship}: wrote {out} ({out.stat().st_size / 1e6:.2f} MB)", flush=True)
     return out
 
@@ -493,9 +521,13 @@ def main(argv=None) -> int:
     ap.add_argument("ships", nargs="+")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--levels", choices=("all", "finest"), default="all")
+    ap.add_argument("--readme-only", action="store_true", help="rewrite README.md from the existing database")
     a = ap.parse_args(argv)
     for s in a.ships:
-        build(s, n_threads=a.threads, levels=a.levels)
+        if a.readme_only:
+            write_readme(load_setup(s), MODELS_DIR / s / "hydro" / f"{s}_hydro.nc")
+        else:
+            build(s, n_threads=a.threads, levels=a.levels)
     return 0
 
 
