@@ -174,8 +174,8 @@ def test_radiation_matrices_symmetric_and_damping_positive(ship):
     # port-starboard symmetry: no coupling between symmetric (1, 3, 5) and antisymmetric (2, 4, 6) modes
     sym, anti = [0, 2, 4], [1, 3, 5]
     for M in (db.A, db.B):
-        cross = np.abs(M[:, sym][:, :, anti]).max()
-        assert cross <= 1e-6 * np.abs(M).max()
+        cross = (np.abs(M).max(axis=0) / _pair_scale(M).max(axis=0))[np.ix_(sym, anti)]
+        assert cross.max() <= 1e-4, cross.max()
 
 
 def test_damping_decays_and_added_mass_tends_to_infinite_frequency_value(ship):
@@ -223,20 +223,46 @@ def test_hydrostatic_stiffness_vs_model_file(ship):
 
 
 def test_long_wave_limits_of_excitation(ship):
-    """At the lowest frequency the ship is quasi-statically excited by the wave it follows:
-    head seas X3 → −(C33 − ω²A33) (heave down positive, crest at O), Im X5 → k C55 (pitch follows the
-    slope), beam seas (travelling to starboard) Im X2 → ω² (m + A22), following seas Im X1 → ω² (m + A11)."""
+    """Long waves excite the ship quasi-statically, as the wave it follows would (crest at O at t = 0):
+    head-sea heave |X3| → C33 (extrapolated to ω = 0 linearly in ω² from the three lowest frequencies,
+    since the ω² A33 and k T corrections are still 3–7 % there) with X3 real and negative (heave is
+    down positive); Im X5 → k C55 (pitch follows the slope); beam seas travelling to starboard
+    Im X2 → ω² (m + A22); following seas Im X1 → ω² (m + A11); roll moment in phase with the slope."""
     db = ship["db"]
     w, k = db.omega[0], db.wavenumber[0]
     head = int(np.argmin(np.abs(db.headings - math.pi)))
     beam = int(np.argmin(np.abs(db.headings - math.pi / 2)))
     X = db.X[0]
-    assert X[head, 2].real == pytest.approx(-(db.C[2, 2] - w ** 2 * db.A[0, 2, 2]), rel=0.02)
-    assert abs(X[head, 2]) == pytest.approx(db.C[2, 2], rel=0.05)
-    assert X[head, 4].imag == pytest.approx(k * db.C[4, 4], rel=0.05)
-    assert X[beam, 1].imag == pytest.approx(w ** 2 * (db.mass + db.A[0, 1, 1]), rel=0.15)
-    assert X[0, 0].imag == pytest.approx(w ** 2 * (db.mass + db.A[0, 0, 0]), rel=0.15)
+    x3 = np.abs(db.X[:3, head, 2])
+    x3_at_zero = np.polyfit(db.omega[:3] ** 2, x3, 1)[1]
+    assert x3_at_zero == pytest.approx(db.C[2, 2], rel=0.01)
+    assert X[head, 2].real < 0.0 and abs(X[head, 2].imag) < 0.05 * abs(X[head, 2])
+    assert X[head, 4].imag == pytest.approx(k * db.C[4, 4], rel=0.02)
+    assert X[beam, 1].imag == pytest.approx(w ** 2 * (db.mass + db.A[0, 1, 1]), rel=0.05)
+    assert X[0, 0].imag == pytest.approx(w ** 2 * (db.mass + db.A[0, 0, 0]), rel=0.05)
     assert X[beam, 3].imag > 0.0     # roll moment in phase with the wave slope (starboard down)
+
+
+def test_froude_krylov_force_matches_independent_pressure_integration(ship):
+    """X_FK recomputed here in vtrials axes and phase convention, −∫ p n_j dS with the incident
+    pressure p = ρ g a e^{−k z} e^{−i k (x cos β + y sin β)} (z down) at the panel centres of the
+    shipped mesh (whole hull), vs the database: all dofs, frequencies and headings within 0.2 % of
+    each dof's largest value. This pins the axes, heading and phase transforms from Capytaine."""
+    db = ship["db"]
+    m = hf.mirror(ship["mesh"])
+    V = m.vertices.copy()
+    V[:, 0] -= db.reference_x_from_midship
+    p = V[m.faces]
+    c = p.mean(axis=1)
+    nA = 0.5 * np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
+    gen = np.concatenate([nA, np.cross(c, nA)], axis=1)          # n_j dS, moments about O
+    k = db.wavenumber
+    X = np.zeros_like(db.X_FK)
+    for ib, b in enumerate(db.headings):
+        phase = np.exp(-np.outer(k, c[:, 2])) * np.exp(-1j * np.outer(k, c[:, 0] * math.cos(b) + c[:, 1] * math.sin(b)))
+        X[:, ib, :] = -db.rho * db.g * phase @ gen
+    err = np.abs(X - db.X_FK).max(axis=(0, 1)) / np.abs(db.X_FK).max(axis=(0, 1))
+    assert np.all(err < 2e-3), err
 
 
 def test_haskind_relation(ship):
