@@ -162,6 +162,16 @@ def _capytaine_body(cpt, setup: ShipSetup, mesh: hf.HullMesh):
     return body
 
 
+def resolution_limit(setup: ShipSetup, mesh: hf.HullMesh) -> tuple[float, float]:
+    """(largest panel radius of hull and lid [m], ω above which it exceeds λ/8 [rad/s]) — the
+    criterion behind Capytaine's mesh-resolution warning."""
+    import capytaine as cpt
+
+    body = _capytaine_body(cpt, setup, mesh)
+    r = float(np.max(body.mesh_including_lid.faces_radiuses))
+    return r, math.sqrt(2.0 * math.pi * setup.g / (8.0 * r))
+
+
 def solve_level(setup: ShipSetup, mesh: hf.HullMesh, omega, headings, *, kochin: bool, n_threads: int = 2) -> dict:
     """Radiation + diffraction (+ ω = ∞ added mass) on one mesh; results in vtrials axes/conventions."""
     import capytaine as cpt
@@ -355,7 +365,8 @@ def _readme(setup: ShipSetup, hyd: dict, levels: list, changes: list, attrs: dic
     for (i, j), name in (((2, 2), "C33 = ρ g A_wp"), ((3, 3), "C44 = ρ g ∇ GM_T"), ((4, 4), "C55 = ρ g ∇ GM_L (+A_wp x_F²)"),
                          ((2, 4), "C35 = −ρ g A_wp x_F")):
         a, b = C[i, j], setup.model_C[i, j]
-        lines.append(f"| {name} | {a:.4e} | {b:.4e} | {a / b if b != 0 else float('nan'):.3f} |")
+        ratio = f"{a / b:.3f}" if b != 0 else "— (ship.toml: 0)"
+        lines.append(f"| {name} | {a:.4e} | {b:.4e} | {ratio} |")
     lines += ["", checks["hydrostatics_note"], "",
               "## Mesh convergence", "",
               "| level | stations × girth | panels (half hull) | lid panels (whole) | BEM time [s] | max A33 | max B33 | max A55 | max amplitude X3, head seas | max amplitude X5, head seas |",
@@ -397,9 +408,11 @@ def _readme(setup: ShipSetup, hyd: dict, levels: list, changes: list, attrs: dic
               f"* Irregular frequencies are removed with a lid at z = −{LID_DEPTH} T inside the hull.",
               "* The parametric hull reproduces the particulars above, not the real lines; local quantities "
               "(pressure, sectional loads) are not representative.",
-              "* Capytaine warns where the largest panel exceeds 1/8 of the wavelength; the mesh levels in "
-              "`hull.toml` were chosen so that the shipped level stays below it over the stored range "
-              "(the lid's panels may exceed it slightly at the top frequency).", "",
+              "* Mesh resolution (Capytaine's rule: largest panel radius ≤ wavelength/8): the shipped hull and "
+              f"lid have r ≤ {float(attrs['mesh_max_panel_radius']):.2f} m, fine enough up to ω = "
+              f"{float(attrs['mesh_resolved_omega_max']):.2f} rad/s"
+              + (", i.e. over the whole stored range." if float(attrs["mesh_resolved_omega_max"]) >= setup.omega[-1]
+                 else f"; the stored frequencies above that are less accurate."), "",
               "## Checks", "",
               "`tests/test_hydro_database.py` (no Capytaine needed): hull particulars from the mesh; "
               "symmetry of A and B and no symmetric/antisymmetric mode coupling; B ≥ 0; B decaying and "
@@ -420,6 +433,9 @@ def write_readme(setup: ShipSetup, nc_path: Path) -> Path:
     mesh = hf.hull_mesh(hf.fit_hullform(setup.particulars), ns, ng)
     hyd = hf.mesh_hydrostatics(mesh)
     hyd["A_M"] = hf.mesh_section_area(mesh, 0.0)
+    pts = mesh.vertices[mesh.faces]
+    hyd["r_max"] = float(np.max(np.linalg.norm(pts - pts.mean(axis=1, keepdims=True), axis=2)))
+    hyd["omega_resolved"] = math.sqrt(2.0 * math.pi * setup.g / (8.0 * hyd["r_max"]))
     conv = json.loads(db.attrs["convergence"])
     text = _readme(setup, hyd, conv["levels"], conv["relative_changes"], db.attrs, db.C,
                    {"hydrostatics_note": db.attrs["hydrostatics_note"]})
@@ -510,6 +526,9 @@ def build(ship: str, models_dir: Path = MODELS_DIR, n_threads: int = 2, levels: 
         "hydrostatics_note": note,
         "hull_particulars_source": setup.hull_source,
     }
+    r_max, w_res = resolution_limit(setup, finest_mesh)
+    attrs["mesh_max_panel_radius"] = r_max
+    attrs["mesh_resolved_omega_max"] = w_res
     out = models_dir / setup.name / "hydro" / f"{setup.name}_hydro.nc"
     write_database(out, setup, finest, attrs)
     write_readme(setup, out)
