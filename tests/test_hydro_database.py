@@ -415,3 +415,40 @@ def test_loader_errors_name_file_and_field(tmp_path):
         f.create_dataset("hydrostatic_stiffness", data=np.zeros((5, 6)))
     with pytest.raises(InputError, match=r"hydrostatic_stiffness: shape \(5, 6\)"):
         load_database(broken("shape", shape))
+
+
+def test_rigid_body_mass_matrix_parallel_axis_and_stored_copy(ship):
+    """M about O from m, G and k_G (Fossen 2011 eq. 3.44): I_O,xx = m (k_xx² + y_G² + z_G²), coupling
+    M[0, 4] = m z_G, M[1, 5] = m x_G; the database stores the same matrix."""
+    from vtrials.physics.seakeeping.build import rigid_body_mass_matrix
+
+    db = ship["db"]
+    m, r, k = db.mass, db.center_of_gravity, db.radii_of_gyration
+    M = rigid_body_mass_matrix(m, r, k)
+    assert M[3, 3] == pytest.approx(m * (k[0] ** 2 + r[1] ** 2 + r[2] ** 2))
+    assert M[4, 4] == pytest.approx(m * (k[1] ** 2 + r[0] ** 2 + r[2] ** 2))
+    assert M[0, 4] == pytest.approx(m * r[2]) and M[1, 5] == pytest.approx(m * r[0])
+    np.testing.assert_allclose(M, M.T)
+    assert np.all(np.linalg.eigvalsh(M) > 0.0)
+    np.testing.assert_allclose(db.mass_matrix, M, rtol=1e-12)
+
+
+def test_capytaine_axes_transform_is_a_rotation_about_x():
+    """(x, y, z)_vtrials → (x − x_O, −y, −z)_Capytaine; generalized coordinates by T = diag(1,−1,−1,1,−1,−1),
+    forces also conjugated (e^{−iωt} → e^{+iωt})."""
+    from vtrials.physics.seakeeping.build import AXES_SIGN, force_to_vtrials, matrix_to_vtrials, to_capytaine_vertices
+
+    R = np.diag([1.0, -1.0, -1.0])
+    assert np.linalg.det(R) == pytest.approx(1.0)        # proper rotation: panel orientation kept
+    v = np.array([[10.0, 2.0, 3.0]])
+    np.testing.assert_allclose(to_capytaine_vertices(v, 1.5), [[8.5, -2.0, -3.0]])
+    # a moment r × F transforms like the rotation of r and F: T on (F, M) equals R on each triple
+    rng = np.random.default_rng(7)
+    r, F = rng.normal(size=3), rng.normal(size=3)
+    gen_v = np.concatenate([F, np.cross(r, F)])
+    gen_c = np.concatenate([R @ F, np.cross(R @ r, R @ F)])
+    np.testing.assert_allclose(AXES_SIGN * gen_c, gen_v)
+    Mc = rng.normal(size=(6, 6))
+    np.testing.assert_allclose(matrix_to_vtrials(Mc), np.diag(AXES_SIGN) @ Mc @ np.diag(AXES_SIGN))
+    Xc = rng.normal(size=6) + 1j * rng.normal(size=6)
+    np.testing.assert_allclose(force_to_vtrials(Xc), AXES_SIGN * np.conj(Xc))

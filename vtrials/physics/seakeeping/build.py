@@ -412,7 +412,7 @@ def _readme(setup: ShipSetup, hyd: dict, levels: list, changes: list, attrs: dic
               f"lid have r ≤ {float(attrs['mesh_max_panel_radius']):.2f} m, fine enough up to ω = "
               f"{float(attrs['mesh_resolved_omega_max']):.2f} rad/s"
               + (", i.e. over the whole stored range." if float(attrs["mesh_resolved_omega_max"]) >= setup.omega[-1]
-                 else f"; the stored frequencies above that are less accurate."), "",
+                 else "; the stored frequencies above that are less accurate."), "",
               "## Checks", "",
               "`tests/test_hydro_database.py` (no Capytaine needed): hull particulars from the mesh; "
               "symmetry of A and B and no symmetric/antisymmetric mode coupling; B ≥ 0; B decaying and "
@@ -468,7 +468,6 @@ def build(ship: str, models_dir: Path = MODELS_DIR, n_threads: int = 2, levels: 
     changes = relative_changes([r["metrics"] for r in records])
     hyd = hf.mesh_hydrostatics(finest_mesh)
     hyd["A_M"] = hf.mesh_section_area(finest_mesh, 0.0)
-    C, Cm = finest["C"], setup.model_C
     mh = setup.model_hydrostatics
     GM_T_mesh = hyd["KB"] + hyd["BM_T"] - mh["KG"]
     GM_L_mesh = hyd["KB"] + hyd["BM_L"] - mh["KG"]
