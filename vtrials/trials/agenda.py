@@ -24,7 +24,8 @@ import dataclasses
 import math
 
 from vtrials.errors import InputError
-from vtrials.schema import flag, integer, num, read_table, text, unknown_key, vector
+from vtrials.schema import (check_name, choice, flag, integer, num, read_table, table, table_list, text, unknown_key,
+                            vector)
 from vtrials.units import DEG, RPM
 
 ORDERS = ("ahead_1_3", "ahead_2_3", "standard", "full", "flank")
@@ -257,11 +258,12 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
         raise InputError(f, "agenda", "expected a table")
     doc = dict(doc)
     trials_tab = doc.pop("trial", None)
-    st_tab = doc.pop("steadiness", {})
+    st_tab = table(doc.pop("steadiness", None), f, "agenda.steadiness")
     rules, _ = read_table(AgendaRules, doc, f, "agenda")
     steadiness, _ = read_table(Steadiness, st_tab, f, "agenda.steadiness")
     if not isinstance(trials_tab, list) or not trials_tab:
         raise InputError(f, "agenda.trial", "expected at least one [[agenda.trial]] table")
+    table_list(trials_tab, f, "agenda.trial")
     trials = []
     number = 0
     names = set()
@@ -272,9 +274,9 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
         sec = f"agenda.trial[{it}]"
         if not isinstance(tab, dict):
             raise InputError(f, sec, "expected a table")
-        kind = tab.get("kind")
-        if kind not in _ITEMS:
-            raise InputError(f, f"{sec}.kind", f"unknown trial kind {kind!r} (allowed: {', '.join(_ITEMS)})")
+        kind = choice(tab.get("kind"), _ITEMS, f, f"{sec}.kind", "trial kind")
+        if "name" in tab:
+            check_name(tab["name"], f, f"{sec}.name")
         item_key, item_cls = _ITEMS[kind]
         tab = dict(tab)
         items = tab.pop(item_key, None)
@@ -296,6 +298,7 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
                                                                f"of {vessel.name} ({max_rudder:g}°)")
         if not isinstance(items, list) or not items:
             raise InputError(f, f"{sec}.{item_key}", f"expected at least one [[agenda.trial.{item_key}]] table")
+        table_list(items, f, f"{sec}.{item_key}")
         runs = []
         for ii, itab in enumerate(items):
             isec = f"{sec}.{item_key}[{ii}]"
