@@ -94,6 +94,8 @@ def _inspect(args) -> int:
     import numpy as np
 
     from vtrials.records.netcdf import RecordError, open_record
+    if Path(args.record).is_dir():
+        raise InputError(args.record, "", "is a directory; expected a trial record file (e.g. DIR/records/NAME.nc)")
     try:
         rec = open_record(args.record)
     except FileNotFoundError:
@@ -144,6 +146,9 @@ def _run_agenda(scn, args) -> int:
         say(f"vtrials: {scn.head.title} — agenda of {len(scn.agenda.runs)} runs, ship {scn.vessel.name}")
     result = simulate_agenda(scn, progress=say)
     doc = write_agenda_outputs(result, args.out, plot=not args.no_plot)
+    for tr in doc["trials"]:  # a quantity the trial's legs cannot determine is reported, not computed
+        for u in tr.get("reduced", {}).get("under_determined", []):
+            print(f"vtrials: warning: {tr['name']}: {u['quantity']} under-determined: {u['why']}", file=sys.stderr)
     if say:
         say(f"trial time {doc['agenda']['total_time_s'] / 3600:.2f} h simulated in {doc['wall_time_s']:.1f} s wall time")
         for tr in doc["trials"]:
@@ -170,9 +175,11 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from vtrials.scenario import load_scenario
             from vtrials.runner.side_by_side import simulate, write_outputs
+            from vtrials.runner.staging import check_out
             if args.threads < 1:
                 raise InputError("--threads", "", "must be at least 1")
             scn = load_scenario(args.scenario)
+            check_out(args.out)  # before simulating: a bad --out is found in a second, not after the run
             if scn.agenda is not None:
                 return _run_agenda(scn, args)
             if not args.quiet:
@@ -192,11 +199,21 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "inspect":
             return _inspect(args)
     except SimulationError as exc:
-        print(f"vtrials: simulation stopped: {exc}", file=sys.stderr)
+        text = str(exc)
+        print(f"vtrials: {text if text.startswith('simulation stopped') else 'simulation stopped: ' + text}",
+              file=sys.stderr)
         return 3
     except VtrialsError as exc:
         print(f"vtrials: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as exc:
+        t = getattr(exc, "trial_time_s", None)
+        at = f" at trial time {t:.1f} s" if t is not None else ""
+        print(f"vtrials: interrupted{at}; nothing written", file=sys.stderr)
+        return 130
+    except OSError as exc:  # the disk filled up, a file vanished under the run, …
+        print(f"vtrials: error: {exc.filename or ''}: {exc.strerror or exc}; nothing written", file=sys.stderr)
+        return 1
     return 2
 
 

@@ -186,6 +186,8 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
          f"{_fmt(sm['max_abs_stw_error_kn'], 3)} kn; 95 % intervals cover the truth on "
          f"{_fmt(_pct(sm['stw_coverage']), 0)} % of legs; current error ≤ "
          f"{_fmt(sm['max_current_error_kn'], 3)} kn.", ""]
+    for u in red.get("under_determined", []):
+        L += [f"**Not reduced — {u['quantity']} is under-determined**: {u['why']}.", ""]
     L += [f"![{f}]({f})" for f in figs] + [""]
     for inst, cal in red["calibrations"].items():
         if "error" in cal:
