@@ -146,6 +146,8 @@ _TOP = ("scenario", "initial", "environment", "maneuver", "agenda", "site", "ins
 
 def load_scenario(path: str | Path) -> Scenario:
     """Read and check a scenario file (and the vessel it names)."""
+    if not isinstance(path, (str, Path)) or not str(path) or "\x00" in str(path):
+        raise InputError("load_scenario()", "path", f"expected the path of a scenario file, got {_short(path)}")
     p = Path(path)
     f = str(path)
     doc = load_toml(p)

@@ -205,6 +205,9 @@ def read_table(cls: type, table: Any, file: str, section: str, *, sourced: bool 
                 src = raw.get("source", default_source)
                 if not (isinstance(src, str) and src.strip()):
                     raise InputError(file, name, "no source given: add source = \"...\" (inline or for the table)")
+                for k in ("unit", "note"):
+                    if k in raw and not isinstance(raw[k], str):
+                        raise InputError(file, f"{name}.{k}", f"expected a string, got {_short(raw[k])}")
                 unit = raw.get("unit")
                 if unit is not None and spec.unit and unit != spec.unit:
                     raise InputError(file, name, f"unit {unit!r} given, but this field is in {spec.unit!r} (SI)")
@@ -268,8 +271,11 @@ def table(value: Any, file: str, name: str, default: Any = None) -> dict:
 
 def table_list(value: Any, file: str, name: str) -> list:
     """value as a list of tables ([[name]] in TOML)."""
-    if not isinstance(value, list) or not all(isinstance(t, dict) for t in value):
+    if not isinstance(value, list):
         raise InputError(file, name, f"expected [[{name.rsplit('.', 1)[-1]}]] tables, got {_short(value)}")
+    for i, t in enumerate(value):
+        if not isinstance(t, dict):
+            raise InputError(file, f"{name}[{i}]", f"expected a table, got {type(t).__name__} {_short(t)}")
     return value
 
 

@@ -165,6 +165,10 @@ def _lc_figures(tr: dict, out: Path) -> list[str]:
         files.append(_save(fig, out, f))
     fig, ax = plt.subplots(figsize=(9, 3.4))
     t = np.array([leg["t_mid"] for leg in red["legs"]]) / 3600
+    if not err["current"]:  # the current was under-determined: the truth alone
+        ax.plot(t, [leg["true_current"][0] / KNOT for leg in err["legs"]], "k.-", label="true current north")
+        ax.plot(t, [leg["true_current"][1] / KNOT for leg in err["legs"]], "k.--", label="true current east")
+        t = t[:0]
     ax.plot(t, [c["truth"][0] / KNOT for c in err["current"]], "k.-", label="true current north")
     ax.plot(t, [c["truth"][1] / KNOT for c in err["current"]], "k.--", label="true current east")
     ax.plot(t, [c["reduced"][0] / KNOT for c in err["current"]], "C0o", label="reduced north")
