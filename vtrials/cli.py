@@ -145,6 +145,7 @@ def _run_agenda(scn, args) -> int:
     if say:
         say(f"vtrials: {scn.head.title} — agenda of {len(scn.agenda.runs)} runs, ship {scn.vessel.name}")
     result = simulate_agenda(scn, progress=say)
+    _SIMULATED[0] = result.simulated_time_s
     doc = write_agenda_outputs(result, args.out, plot=not args.no_plot)
     for tr in doc["trials"]:  # a quantity the trial's legs cannot determine is reported, not computed
         for u in tr.get("reduced", {}).get("under_determined", []):
@@ -159,7 +160,11 @@ def _run_agenda(scn, args) -> int:
     return 0
 
 
+_SIMULATED = [None]  # trial time simulated by the finished simulation of this call (for the Ctrl-C line)
+
+
 def main(argv: list[str] | None = None) -> int:
+    _SIMULATED[0] = None
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
@@ -186,6 +191,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"vtrials: {scn.head.title} — {len(scn.maneuvers)} maneuver(s), ship {scn.vessel.name}",
                       flush=True)
             result = simulate(scn, nthread=args.threads)
+            _SIMULATED[0] = result.simulated_time_s
             doc = write_outputs(result, args.out, plot=not args.no_plot)
             if not args.quiet:
                 print(f"simulated {doc['simulated_time_s']:.1f} s in {doc['wall_time_s']:.2f} s wall time")
@@ -207,8 +213,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"vtrials: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
-        t = getattr(exc, "trial_time_s", None)
-        at = f" at trial time {t:.1f} s" if t is not None else ""
+        t = getattr(exc, "trial_time_s", _SIMULATED[0])
+        at = (" before the simulation started" if t is None else f" at trial time {t:.1f} s"
+              + (" (writing the outputs)" if _SIMULATED[0] is not None else ""))
         print(f"vtrials: interrupted{at}; nothing written", file=sys.stderr)
         return 130
     except OSError as exc:  # the disk filled up, a file vanished under the run, …

@@ -396,7 +396,8 @@ class Simulator:
         q = self.qpos[i]
         v = self.qvel[i]
         msg = (f"simulation stopped at t = {self.time[i]:.3f} s (ship {i}): {text}; "
-               f"state: qpos {np.array2string(q, precision=4)}, qvel {np.array2string(v, precision=4)}")
+               f"state: qpos {np.array2string(q, precision=4, max_line_width=10 ** 6)}, "
+               f"qvel {np.array2string(v, precision=4, max_line_width=10 ** 6)}")
         raise SimulationError(msg, time_s=float(self.time[i]), ship=i)
 
     def check(self) -> None:

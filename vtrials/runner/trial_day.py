@@ -92,17 +92,17 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)
     try:
         crew.run_agenda()
+        t_ins = time.perf_counter()
+        iset.flush()
+        crew.instrument_wall_s += time.perf_counter() - t_ins
+        timings["simulate_s"] = time.perf_counter() - t_wall
+        timings["instruments_s"] = crew.instrument_wall_s
+        t1 = time.perf_counter()
+        calm = calm_water_truth(scn, crew)
+        calm.update(spiral_truth(scn, crew))
     except KeyboardInterrupt as exc:  # the CLI names the trial time it stopped at
         exc.trial_time_s = float(crew.t)
         raise
-    t_ins = time.perf_counter()
-    iset.flush()
-    crew.instrument_wall_s += time.perf_counter() - t_ins
-    timings["simulate_s"] = time.perf_counter() - t_wall
-    timings["instruments_s"] = crew.instrument_wall_s
-    t1 = time.perf_counter()
-    calm = calm_water_truth(scn, crew)
-    calm.update(spiral_truth(scn, crew))
     timings["calm_water_s"] = time.perf_counter() - t1
     return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings)
 
