@@ -118,6 +118,8 @@ def _like(value, ref, f: str, name: str):
                                       f"got {value!r}"[:200])
         return value
     if isinstance(ref, dict):
+        if set(ref) <= {"mean", "sd"} and isinstance(value, (int, float)):  # a distribution: a bare number is its sd
+            return check_value(_NONNEG, value, f, name)
         if not isinstance(value, dict):
             raise InputError(f, name, f"expected a table with keys {', '.join(ref)}, got {value!r}"[:200])
         for k in value:
@@ -125,9 +127,11 @@ def _like(value, ref, f: str, name: str):
                 raise unknown_key(f, name, k, list(ref))
         return {k: _like(v, ref[k], f, f"{name}.{k}") for k, v in value.items()}
     if isinstance(ref, list):
-        if not isinstance(value, list) or (ref and len(value) != len(ref)):
-            raise InputError(f, name, f"expected a list of {len(ref)} numbers, got {value!r}"[:200])
-        return [_like(v, ref[0] if ref else 0.0, f, f"{name}[{k}]") for k, v in enumerate(value)]
+        if not isinstance(value, list) or not value:
+            raise InputError(f, name, f"expected a list of numbers, got {value!r}"[:200])
+        if ref and isinstance(ref[0], (dict, list)):
+            return [_like(v, ref[0], f, f"{name}[{k}]") for k, v in enumerate(value)]
+        return [check_value(Spec("num"), v, f, f"{name}[{k}]") for k, v in enumerate(value)]
     if isinstance(ref, str):
         if not isinstance(value, str):
             raise InputError(f, name, f"expected a string, got {value!r}"[:200])
