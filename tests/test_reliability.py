@@ -227,8 +227,15 @@ def bad_scenario(draw, bases=tuple(BASES)):
 
 
 @functools.lru_cache(maxsize=None)
-def _vessel(name, file_for_errors=None, field_for_errors="ship"):
+def _builtin_vessel(name, file_for_errors=None, field_for_errors="ship"):
     return load_vessel(name, file_for_errors=file_for_errors, field_for_errors=field_for_errors)
+
+
+def _vessel(name, file_for_errors=None, field_for_errors="ship"):
+    """load_vessel, cached for the built-in models only (a user's model folder is read every time)."""
+    if "/" in str(name):
+        return load_vessel(name, file_for_errors=file_for_errors, field_for_errors=field_for_errors)
+    return _builtin_vessel(name, file_for_errors, field_for_errors)
 
 
 @pytest.fixture(scope="module")
