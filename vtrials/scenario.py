@@ -28,7 +28,7 @@ import numpy as np
 from vtrials.errors import InputError
 from vtrials.trials.programs import KINDS, ORDER_CHOICES
 from vtrials.physics.environment.wind import Wind
-from vtrials.schema import (_short, check_name, choice, flag, integer, load_toml, num, read_table, table, table_list, text,
+from vtrials.schema import (_short, check_name, did_you_mean, choice, flag, integer, load_toml, num, read_table, table, table_list, text,
                             unknown_key)
 from vtrials.physics.environment.current import Current
 from vtrials.units import DEG, KNOT, froude_to_speed
@@ -212,7 +212,7 @@ def load_scenario(path: str | Path) -> Scenario:
         for field in ("trailed_shaft", "locked_shaft"):
             val = getattr(m, field)
             if val is not None and val not in shaft_names:
-                raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r} (shafts of {vessel.name}: "
+                raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r}{did_you_mean(val, shaft_names)} (shafts of {vessel.name}: "
                                                       f"{', '.join(shaft_names)})")
         if m.trailed_shaft is not None and m.trailed_shaft == m.locked_shaft:
             raise InputError(f, f"{sec}.locked_shaft", "a shaft cannot be trailed and locked at once")

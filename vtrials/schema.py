@@ -254,6 +254,14 @@ def check_name(value: Any, file: str, name: str) -> str:
     return value
 
 
+def did_you_mean(value: Any, choices) -> str:
+    """"; did you mean 'x'?" for the closest of choices to a misspelt value ("" if none is close)."""
+    if not isinstance(value, str):
+        return ""
+    close = difflib.get_close_matches(value, [str(c) for c in choices], n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
 def _short(value: Any, n: int = 60) -> str:
     """repr of a value on one line, cut to about n characters."""
     r = repr(value)

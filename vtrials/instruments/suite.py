@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from vtrials.errors import InputError
-from vtrials.schema import check_name, check_value, load_toml, num, read_table, table, text, unknown_key, Spec
+from vtrials.schema import did_you_mean, check_name, check_value, load_toml, num, read_table, table, text, unknown_key, Spec
 from vtrials.instruments.devices import KINDS, RudderAngle, ShaftDevice, SpecError
 
 CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
@@ -211,14 +211,15 @@ class InstrumentSet:
         site = np.zeros(3)
         if e.site is not None:
             if e.site not in v.sites:
-                raise InputError(f, f"{where}.site", f"unknown site {e.site!r} (sites of {v.name}: "
+                raise InputError(f, f"{where}.site", f"unknown site {e.site!r}{did_you_mean(e.site, v.sites)} (sites of {v.name}: "
                                                      f"{', '.join(sorted(v.sites))})")
             site = v.sites[e.site]
         try:
             if issubclass(cls, ShaftDevice):
                 names = [s.name for s in v.shafts]
                 if e.shaft not in names:
-                    raise InputError(f, f"{where}.shaft", f"{e.shaft!r} is not a shaft of {v.name} ({', '.join(names)})")
+                    raise InputError(f, f"{where}.shaft", f"{e.shaft!r} is not a shaft of {v.name}{did_you_mean(e.shaft, names)} "
+                                                          f"({', '.join(names)})")
                 k = names.index(e.shaft)
                 pk = [p.name for p in v.propellers].index(v.shafts[k].propeller)
                 pos = np.array([v.propellers[pk].x, v.propellers[pk].y, v.propellers[pk].z])
@@ -227,7 +228,7 @@ class InstrumentSet:
             if cls is RudderAngle:
                 names = [r.name for r in v.rudders]
                 if e.rudder not in names:
-                    raise InputError(f, f"{where}.rudder", f"{e.rudder!r} is not a rudder of {v.name} "
+                    raise InputError(f, f"{where}.rudder", f"{e.rudder!r} is not a rudder of {v.name}{did_you_mean(e.rudder, names)} "
                                                            f"({', '.join(names)})")
                 k = names.index(e.rudder)
                 rd = v.rudders[k]

@@ -24,7 +24,7 @@ import dataclasses
 import math
 
 from vtrials.errors import InputError
-from vtrials.schema import (check_name, choice, flag, integer, num, read_table, table, table_list, text, unknown_key,
+from vtrials.schema import (did_you_mean, check_name, choice, flag, integer, num, read_table, table, table_list, text, unknown_key,
                             vector)
 from vtrials.units import DEG, RPM
 
@@ -209,7 +209,7 @@ def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None,
     cp = any(sh.controllable_pitch for sh in vessel.shafts)
     if s.order is not None:
         if s.order not in vessel.telegraph:
-            raise InputError(f, f"{sec}.order", f"{vessel.name} has no telegraph position {s.order!r} (it has "
+            raise InputError(f, f"{sec}.order", f"{vessel.name} has no telegraph position {s.order!r}{did_you_mean(s.order, vessel.telegraph)} (it has "
                                                 f"{', '.join(vessel.telegraph)})")
         rps, pitch = vessel.telegraph[s.order]
         if s.pitch is not None:
@@ -236,7 +236,7 @@ def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None,
         if val is None:
             continue
         if val not in names:
-            raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r} (shafts of {vessel.name}: "
+            raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r}{did_you_mean(val, names)} (shafts of {vessel.name}: "
                                                   f"{', '.join(names)})")
         if modes[names.index(val)] != "governed":
             raise InputError(f, f"{sec}.{field}", "a shaft cannot be trailed and locked at once")
@@ -368,7 +368,8 @@ def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pit
             raise InputError(f, f"{sec}.to_order", "a speed_change needs to_order or to_rpm (not both)")
         if m.to_order is not None:
             if m.to_order not in vessel.telegraph:
-                raise InputError(f, f"{sec}.to_order", f"{vessel.name} has no telegraph position {m.to_order!r}")
+                raise InputError(f, f"{sec}.to_order", f"{vessel.name} has no telegraph position {m.to_order!r}"
+                                                      f"{did_you_mean(m.to_order, vessel.telegraph)}")
             p["to_rps"], p["to_pitch"] = vessel.telegraph[m.to_order]
             p["to_order"] = m.to_order
         else:
