@@ -481,6 +481,16 @@ def test_out_checked_before_simulating(tmp_path, capsys):
                 continue  # root writes anywhere
             assert code == 2 and len(err.strip().splitlines()) == 1 and frag in err, err
             assert "--out" in err
+        mine = tmp_path / "mine"  # the run replaces --out whole: never a directory of the user's files
+        mine.mkdir()
+        (mine / "thesis.tex").write_text("x")
+        code = main(["run", str(SCENARIOS / "kvlcc2_l7_turning.toml"), "--out", str(mine), "--quiet"])
+        err = capsys.readouterr().err
+        assert code == 2 and "not a vtrials output (thesis.tex)" in err, err
+        assert [x.name for x in mine.iterdir()] == ["thesis.tex"]
+        code = main(["run", str(SCENARIOS / "kvlcc2_l7_turning.toml"), "--out", ".", "--quiet"])
+        err = capsys.readouterr().err
+        assert code == 2 and "working directory" in err, err
     finally:
         ro.chmod(0o755)
     assert f.read_text() == "x"

@@ -56,9 +56,27 @@ def check_out(out: str | Path) -> Path:
             raise InputError(name, "--out", f"cannot write in {anc} (permission denied)")
         if p.exists() and not os.access(p, os.W_OK | os.X_OK):
             raise InputError(name, "--out", "the directory is not writable (permission denied)")
+        if p.exists():
+            here = Path.cwd().resolve()
+            if p.resolve() == here or p.resolve() in here.parents:
+                raise InputError(name, "--out", "is the working directory or holds it; the run replaces --out "
+                                                "whole: give a directory of its own")
+            foreign = sorted(x.name for x in p.iterdir() if not _is_output(x))
+            if foreign:
+                raise InputError(name, "--out", f"holds files that are not a vtrials output ({', '.join(foreign[:3])}"
+                                                f"{', …' if len(foreign) > 3 else ''}); the run replaces --out whole: "
+                                                f"give an empty or new directory, or a previous run's")
     except OSError as exc:
         raise InputError(name, "--out", f"cannot use this directory ({exc.strerror})") from None
     return p
+
+
+OUTPUT_NAMES = ("results.json", "truth.nc", "records", "report.md", "trajectory.png")
+
+
+def _is_output(x: Path) -> bool:
+    """An entry a vtrials run writes into --out (so a directory of such entries may be replaced)."""
+    return x.name in OUTPUT_NAMES or (x.suffix == ".png" and x.is_file())
 
 
 def _alive(pid: int) -> bool:
