@@ -145,6 +145,8 @@ def _inspect(args) -> int:
     import numpy as np
 
     from vtrials.records.netcdf import RecordError, open_record
+    if Path(args.record).is_dir():
+        raise InputError(args.record, "", "is a directory; expected a trial record file (e.g. DIR/records/NAME.nc)")
     try:
         rec = open_record(args.record)
     except FileNotFoundError:
@@ -194,7 +196,11 @@ def _run_agenda(scn, args) -> int:
     if say:
         say(f"vtrials: {scn.head.title} — agenda of {len(scn.agenda.runs)} runs, ship {scn.vessel.name}")
     result = simulate_agenda(scn, progress=say)
+    _SIMULATED[0] = result.simulated_time_s
     doc = write_agenda_outputs(result, args.out, plot=not args.no_plot)
+    for tr in doc["trials"]:  # a quantity the trial's legs cannot determine is reported, not computed
+        for u in tr.get("reduced", {}).get("under_determined", []):
+            print(f"vtrials: warning: {tr['name']}: {u['quantity']} under-determined: {u['why']}", file=sys.stderr)
     if say:
         say(f"trial time {doc['agenda']['total_time_s'] / 3600:.2f} h simulated in {doc['wall_time_s']:.1f} s wall time")
         for tr in doc["trials"]:
@@ -205,7 +211,11 @@ def _run_agenda(scn, args) -> int:
     return 0
 
 
+_SIMULATED = [None]  # trial time simulated by the finished simulation of this call (for the Ctrl-C line)
+
+
 def main(argv: list[str] | None = None) -> int:
+    _SIMULATED[0] = None
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
@@ -221,15 +231,18 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from vtrials.scenario import load_scenario
             from vtrials.runner.side_by_side import simulate, write_outputs
+            from vtrials.runner.staging import check_out
             if args.threads < 1:
                 raise InputError("--threads", "", "must be at least 1")
             scn = load_scenario(args.scenario)
+            check_out(args.out)  # before simulating: a bad --out is found in a second, not after the run
             if scn.agenda is not None:
                 return _run_agenda(scn, args)
             if not args.quiet:
                 print(f"vtrials: {scn.head.title} — {len(scn.maneuvers)} maneuver(s), ship {scn.vessel.name}",
                       flush=True)
             result = simulate(scn, nthread=args.threads)
+            _SIMULATED[0] = result.simulated_time_s
             doc = write_outputs(result, args.out, plot=not args.no_plot)
             if not args.quiet:
                 print(f"simulated {doc['simulated_time_s']:.1f} s in {doc['wall_time_s']:.2f} s wall time")
@@ -245,11 +258,22 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "campaign":
             return _campaign(args)
     except SimulationError as exc:
-        print(f"vtrials: simulation stopped: {exc}", file=sys.stderr)
+        text = str(exc)
+        print(f"vtrials: {text if text.startswith('simulation stopped') else 'simulation stopped: ' + text}",
+              file=sys.stderr)
         return 3
     except VtrialsError as exc:
         print(f"vtrials: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as exc:
+        t = getattr(exc, "trial_time_s", _SIMULATED[0])
+        at = (" before the simulation started" if t is None else f" at trial time {t:.1f} s"
+              + (" (writing the outputs)" if _SIMULATED[0] is not None else ""))
+        print(f"vtrials: interrupted{at}; nothing written", file=sys.stderr)
+        return 130
+    except OSError as exc:  # the disk filled up, a file vanished under the run, …
+        print(f"vtrials: error: {exc.filename or ''}: {exc.strerror or exc}; nothing written", file=sys.stderr)
+        return 1
     return 2
 
 

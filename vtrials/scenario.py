@@ -28,7 +28,8 @@ import numpy as np
 from vtrials.errors import InputError
 from vtrials.trials.programs import KINDS, ORDER_CHOICES
 from vtrials.physics.environment.wind import Wind
-from vtrials.schema import flag, integer, load_toml, num, read_table, text, unknown_key
+from vtrials.schema import (_short, check_name, did_you_mean, choice, flag, integer, load_toml, num, read_table, table, table_list, text,
+                            unknown_key)
 from vtrials.physics.environment.current import Current
 from vtrials.units import DEG, KNOT, froude_to_speed
 from vtrials.physics.vessel import Vessel, load_vessel
@@ -66,6 +67,10 @@ class Environment:
                                lo_open=True, default=10000.0)
 
 
+MAX_GRADIENT_CURRENT_KN = 10.0  # the steady current's own bound (Current.speed_kn)
+SITE_EXTENT_M = 100000.0  # every surveyed point lies within 100 km of the range's origin (a trial area)
+
+
 @dataclasses.dataclass(frozen=True)
 class Site:
     """The trial site as the trials team surveyed it (positions north, east in the range's frame, m)."""
@@ -76,8 +81,9 @@ class Site:
     hydrophone_side: float = num("side of the hydrophone pair 1→2 the ship works on (±1)", "", -1.0, 1.0,
                                  default=-1.0)
     range_center_north_m: float = num("centre of the measured course (runs are laid over it), north", "m",
-                                      default=0.0)
-    range_center_east_m: float = num("centre of the measured course, east", "m", default=0.0)
+                                      -SITE_EXTENT_M, SITE_EXTENT_M, default=0.0)
+    range_center_east_m: float = num("centre of the measured course, east", "m", -SITE_EXTENT_M, SITE_EXTENT_M,
+                                     default=0.0)
 
 
 DEFAULT_TRANSPONDERS = [[-10000.0, -6000.0], [-10000.0, 6000.0]]  # 10 km south of the range centre
@@ -85,12 +91,23 @@ DEFAULT_HYDROPHONES = [[-600.0, -800.0], [-600.0, 800.0]]
 
 
 def _points(val, f: str, field: str, n_min: int) -> list:
+    """Surveyed points: at least n_min [north, east] pairs, finite, within the trial area, at least
+    1 m apart (coincident stations give no fix)."""
     ok = isinstance(val, list) and len(val) >= n_min and all(
         isinstance(p, list) and len(p) == 2 and all(isinstance(c, (int, float)) and not isinstance(c, bool)
                                                     for c in p) for p in val)
     if not ok:
-        raise InputError(f, field, f"expected at least {n_min} [north, east] pairs in metres, got {val!r}")
-    return [[float(a), float(b)] for a, b in val]
+        raise InputError(f, field, f"expected at least {n_min} [north, east] pairs in metres, got {_short(val)}")
+    pts = [[float(a), float(b)] for a, b in val]
+    for k, (a, b) in enumerate(pts):
+        if not (math.isfinite(a) and math.isfinite(b) and abs(a) <= SITE_EXTENT_M and abs(b) <= SITE_EXTENT_M):
+            raise InputError(f, f"{field}[{k}]", f"{_short(val[k])} is out of range: expected finite metres within "
+                                                 f"±{SITE_EXTENT_M:g} m of the range origin")
+        for j in range(k):
+            if math.hypot(a - pts[j][0], b - pts[j][1]) < 1.0:
+                raise InputError(f, f"{field}[{k}]", f"coincides with {field}[{j}] (stations must be at least "
+                                                     f"1 m apart)")
+    return pts
 
 
 @dataclasses.dataclass
@@ -131,6 +148,8 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     """Read and check a scenario file (and the vessel it names). ``doc``: the file's tables already
     read (and changed, e.g. by a campaign's draws); ``path`` then names it in messages and anchors
     relative paths. A ``[campaign]`` table is read by :mod:`vtrials.campaign` and ignored here."""
+    if not isinstance(path, (str, Path)) or not str(path) or "\x00" in str(path):
+        raise InputError("load_scenario()", "path", f"expected the path of a scenario file, got {_short(path)}")
     p = Path(path)
     f = str(path)
     doc = load_toml(p) if doc is None else doc
@@ -141,10 +160,10 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
         raise InputError(f, "scenario", "missing table [scenario]")
     head, _ = read_table(Head, doc["scenario"], f, "scenario")
     ship = head.ship
-    if "/" in ship or ship.endswith(".toml"):  # a model folder of the user's, relative to the scenario
+    if "/" in ship or "\\" in ship or ship.endswith(".toml"):  # a model folder of the user's, relative to the scenario
         ship = str((p.parent / ship).resolve())
     vessel = load_vessel(ship, file_for_errors=f, field_for_errors="scenario.ship")
-    init, _ = read_table(Initial, doc.get("initial", {}), f, "initial")
+    init, _ = read_table(Initial, table(doc.get("initial"), f, "initial"), f, "initial")
     given = [k for k in ("froude_number", "speed_kn", "speed_mps", "engine_order") if getattr(init, k) is not None]
     has_agenda = "agenda" in doc
     if has_agenda and "maneuver" in doc:
@@ -152,21 +171,24 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     if len(given) > 1 or (len(given) == 0 and not has_agenda):
         raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps, engine_order"
                          + (f" (got {', '.join(given)})" if given else ""))
-    env_tab = dict(doc.get("environment", {}))
-    if not isinstance(env_tab, dict):
-        raise InputError(f, "environment", "expected a table")
-    cur_tab = env_tab.pop("current", {})
-    wind_tab = env_tab.pop("wind", {})
+    env_tab = table(doc.get("environment"), f, "environment")
+    cur_tab = table(env_tab.pop("current", None), f, "environment.current")
+    wind_tab = table(env_tab.pop("wind", None), f, "environment.wind")
     env, _ = read_table(Environment, env_tab, f, "environment")
     if env.water_depth_m <= vessel.particulars.draught:
         raise InputError(f, "environment.water_depth_m", f"{env.water_depth_m} m does not float the ship "
                                                          f"(draught {vessel.particulars.draught} m)")
     current, _ = read_table(Current, cur_tab, f, "environment.current")
+    for key in ("reference_north_m", "reference_east_m"):
+        val = getattr(current, key)
+        if abs(val) > SITE_EXTENT_M:
+            raise InputError(f, f"environment.current.{key}", f"{val!r} is out of range: expected a number in "
+                                                               f"[{-SITE_EXTENT_M:g}, {SITE_EXTENT_M:g}] m")
     wind, _ = read_table(Wind, wind_tab, f, "environment.wind")
     if wind.speed_kn > 0 and vessel.windage is None:
         raise InputError(f, "environment.wind.speed_kn", f"{vessel.name} has no [windage] data for wind loads")
-    items = doc.get("maneuver", [])
-    if not has_agenda and (not isinstance(items, list) or not items):
+    items = table_list(doc.get("maneuver", []), f, "maneuver")
+    if not has_agenda and not items:
         raise InputError(f, "maneuver", "expected at least one [[maneuver]] table (or an [agenda])")
     maneuvers = []
     names = set()
@@ -175,9 +197,9 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
         sec = f"maneuver[{i}]"
         if not isinstance(tab, dict):
             raise InputError(f, sec, "expected a table")
-        kind = tab.get("kind")
-        if kind not in KINDS:
-            raise InputError(f, f"{sec}.kind", f"unknown maneuver kind {kind!r} (allowed: {', '.join(KINDS)})")
+        kind = choice(tab.get("kind"), KINDS, f, f"{sec}.kind", "maneuver kind")
+        if "name" in tab:
+            check_name(tab["name"], f, f"{sec}.name")
         m, _ = read_table(KINDS[kind], tab, f, sec, extra_keys=("kind",))
         if m.name in names:
             raise InputError(f, f"{sec}.name", f"duplicate maneuver name {m.name!r}")
@@ -192,19 +214,26 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
         for field in ("trailed_shaft", "locked_shaft"):
             val = getattr(m, field)
             if val is not None and val not in shaft_names:
-                raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r} (shafts of {vessel.name}: "
+                raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r}{did_you_mean(val, shaft_names)} (shafts of {vessel.name}: "
                                                       f"{', '.join(shaft_names)})")
         if m.trailed_shaft is not None and m.trailed_shaft == m.locked_shaft:
             raise InputError(f, f"{sec}.locked_shaft", "a shaft cannot be trailed and locked at once")
         if m.trailed_shaft is not None and m.locked_shaft is not None and len(shaft_names) == 2:
             raise InputError(f, f"{sec}.locked_shaft", "no shaft would be left driving")
         maneuvers.append(m)
-    site_tab = dict(doc.get("site", {}))
-    if not isinstance(site_tab, dict):
-        raise InputError(f, "site", "expected a table")
+    site_tab = table(doc.get("site"), f, "site")
     tr = _points(site_tab.pop("transponders", DEFAULT_TRANSPONDERS), f, "site.transponders", 2)
     hy = _points(site_tab.pop("hydrophones", DEFAULT_HYDROPHONES), f, "site.hydrophones", 2)
     site_obj, _ = read_table(Site, site_tab, f, "site")
+    if current.gradient_kn_per_nmi != 0.0:  # the gradient's current at the range must stay a sea current
+        d = math.hypot(site_obj.range_center_north_m - current.reference_north_m,
+                       site_obj.range_center_east_m - current.reference_east_m)
+        at = abs(current.gradient_kn_per_nmi) * d / 1852.0
+        if at > MAX_GRADIENT_CURRENT_KN:
+            raise InputError(f, "environment.current.reference_north_m",
+                             f"the gradient gives {at:.3g} kn at the range centre, {d:.0f} m from the reference "
+                             f"point: move the reference within {MAX_GRADIENT_CURRENT_KN * 1852.0 / abs(current.gradient_kn_per_nmi):.0f} m "
+                             f"of the range centre (at most {MAX_GRADIENT_CURRENT_KN:g} kn from the gradient there)")
     site = {"transponders": tr, "hydrophones": hy, "transponder_side": site_obj.transponder_side,
             "hydrophone_side": site_obj.hydrophone_side, "latitude_deg": site_obj.latitude_deg,
             "range_center": [site_obj.range_center_north_m, site_obj.range_center_east_m],
@@ -212,8 +241,9 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     agenda = None
     if has_agenda:
         from vtrials.trials.agenda import load_agenda
-        agenda = load_agenda(doc["agenda"], vessel, f)
-    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []), agenda)
+        agenda = load_agenda(table(doc["agenda"], f, "agenda"), vessel, f)
+    instruments = table_list(doc.get("instrument", []), f, "instrument")
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda)
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
     from vtrials.instruments.suite import InstrumentSet
     InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)

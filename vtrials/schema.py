@@ -133,7 +133,7 @@ def check_value(spec: Spec, value: Any, file: str, name: str) -> Any:
     """Check one value against its spec; return it converted (int→float for numbers)."""
     if spec.kind in ("num", "int"):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
+            raise InputError(file, name, f"expected {spec.allowed()}, got {_short(value)}")
         if spec.kind == "int":
             if isinstance(value, float):
                 if not value.is_integer():
@@ -157,7 +157,9 @@ def check_value(spec: Spec, value: Any, file: str, name: str) -> Any:
         if not isinstance(value, str):
             raise InputError(file, name, f"expected {spec.allowed()}, got {value!r}")
         if spec.choices and value not in spec.choices:
-            raise InputError(file, name, f"{value!r} is not allowed: expected {spec.allowed()}")
+            close = difflib.get_close_matches(value, spec.choices, n=1, cutoff=0.6)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise InputError(file, name, f"{_short(value)} is not allowed{hint}: expected {spec.allowed()}")
         return value
     if spec.kind == "flag":
         if not isinstance(value, bool):
@@ -203,6 +205,9 @@ def read_table(cls: type, table: Any, file: str, section: str, *, sourced: bool 
                 src = raw.get("source", default_source)
                 if not (isinstance(src, str) and src.strip()):
                     raise InputError(file, name, "no source given: add source = \"...\" (inline or for the table)")
+                for k in ("unit", "note"):
+                    if k in raw and not isinstance(raw[k], str):
+                        raise InputError(file, f"{name}.{k}", f"expected a string, got {_short(raw[k])}")
                 unit = raw.get("unit")
                 if unit is not None and spec.unit and unit != spec.unit:
                     raise InputError(file, name, f"unit {unit!r} given, but this field is in {spec.unit!r} (SI)")
@@ -230,3 +235,68 @@ def doc_table(cls: type) -> list[tuple[str, str, str]]:
         if s is not None:
             rows.append((f.name, s.allowed(), s.doc))
     return rows
+
+
+# ------------------------------------------------------------------ shared checks
+NAME_PATTERN = r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}"
+NAME_ALLOWED = ("a name of 1 to 64 characters: letters, digits, '_', '-', '.', starting with a letter or "
+                "digit (it becomes a file name)")
+
+
+def check_name(value: Any, file: str, name: str) -> str:
+    """A name that becomes a file or group name (maneuver, trial, instrument): the safe pattern
+    :data:`NAME_PATTERN` — no path separators, no '.' or '..', no NUL, at most 64 characters."""
+    import re
+    if not isinstance(value, str):
+        raise InputError(file, name, f"expected {NAME_ALLOWED}, got {_short(value)}")
+    if re.fullmatch(NAME_PATTERN, value) is None:
+        raise InputError(file, name, f"{_short(value)} is not allowed: expected {NAME_ALLOWED}")
+    return value
+
+
+def did_you_mean(value: Any, choices) -> str:
+    """"; did you mean 'x'?" for the closest of choices to a misspelt value ("" if none is close)."""
+    if not isinstance(value, str):
+        return ""
+    close = difflib.get_close_matches(value, [str(c) for c in choices], n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def _short(value: Any, n: int = 60) -> str:
+    """repr of a value on one line, cut to about n characters."""
+    r = repr(value)
+    return r if len(r) <= n else r[:n - 3] + "..."
+
+
+def table(value: Any, file: str, name: str, default: Any = None) -> dict:
+    """value as a table (a copy); None → default (an empty table); anything else is an error."""
+    if value is None:
+        return dict(default or {})
+    if not isinstance(value, dict):
+        raise InputError(file, name, f"expected a table, got {type(value).__name__} {_short(value)}")
+    return dict(value)
+
+
+def table_list(value: Any, file: str, name: str) -> list:
+    """value as a list of tables ([[name]] in TOML)."""
+    if not isinstance(value, list):
+        raise InputError(file, name, f"expected [[{name.rsplit('.', 1)[-1]}]] tables, got {_short(value)}")
+    for i, t in enumerate(value):
+        if not isinstance(t, dict):
+            raise InputError(file, f"{name}[{i}]", f"expected a table, got {type(t).__name__} {_short(t)}")
+    return value
+
+
+def choice(value: Any, choices, file: str, name: str, what: str) -> str:
+    """value as one of choices (a string); missing → "missing field", misspelt → "did you mean"."""
+    choices = list(choices)
+    allowed = ", ".join(choices)
+    if value is None:
+        raise InputError(file, name, f"missing field (expected one of {allowed})")
+    if not isinstance(value, str):
+        raise InputError(file, name, f"expected a string, one of {allowed}; got {_short(value)}")
+    if value not in choices:
+        close = difflib.get_close_matches(value, choices, n=1, cutoff=0.6)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise InputError(file, name, f"unknown {what} {_short(value)}{hint} (allowed: {allowed})")
+    return value

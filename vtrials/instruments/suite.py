@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from vtrials.errors import InputError
-from vtrials.schema import load_toml, num, read_table, text, unknown_key
+from vtrials.schema import did_you_mean, check_name, check_value, load_toml, num, read_table, table, text, unknown_key, Spec
 from vtrials.instruments.devices import KINDS, RudderAngle, ShaftDevice, SpecError
 
 CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
@@ -61,10 +61,85 @@ def _entries(items, f: str, section: str) -> list[tuple[Entry, dict, str]]:
         if not isinstance(tab, dict):
             raise InputError(f, f"{section}[{i}]", "expected a table")
         tab = dict(tab)
-        sets = tab.pop("set", {})
+        sets = table(tab.pop("set", None), f, f"{section}[{i}].set")
+        if "name" in tab:
+            check_name(tab["name"], f, f"{section}[{i}].name")
         e, _ = read_table(Entry, tab, f, f"{section}[{i}]")
         out.append((e, sets, f"{section}[{i}]"))
     return out
+
+
+_NONNEG = Spec("num", lo=0.0)
+_SETTINGS = {  # what each common catalogue parameter accepts (catalogue.toml's header gives the meaning)
+    "rate_hz": Spec("num", unit="Hz", lo=0.0, hi=1000.0, lo_open=True),
+    "noise": _NONNEG, "resolution": _NONNEG, "random_walk": _NONNEG, "latency_s": Spec("num", unit="s", lo=0.0, hi=3600.0),
+    "hold_s": Spec("num", unit="s", lo=0.0, hi=3600.0), "clock_offset_s": Spec("num", unit="s", lo=0.0, hi=3600.0),
+    "dropout_p": Spec("num", lo=0.0, hi=1.0, hi_open=True), "misalignment_deg": Spec("num", unit="deg", lo=0.0, hi=90.0),
+}
+_DIST = {"bias": {"mean": Spec("num"), "sd": _NONNEG}, "scale": {"mean": Spec("num", lo=-1.0, hi=1.0, lo_open=True),
+                                                                  "sd": Spec("num", lo=0.0, hi=1.0)},
+         "gauss_markov": {"sd": _NONNEG, "tau_s": Spec("num", unit="s", lo=0.0, lo_open=True)}}
+
+
+def check_setting(key: str, value, catalogue_value, f: str, name: str):
+    """Check one ``[instrument.set]`` value: the common parameters by their allowed range (noise,
+    resolution, standard deviations ≥ 0, rates > 0, probabilities in [0, 1), ranges lo < hi); a
+    device's own parameters must have the shape of the catalogue's value (a number, a table of
+    numbers, a list of numbers) and be finite, and non-negative where the catalogue's is."""
+    if key in _SETTINGS:
+        return check_value(_SETTINGS[key], value, f, name)
+    if key in _DIST:
+        fields = _DIST[key]
+        if not isinstance(value, dict):
+            if key == "bias":  # a bare number is the standard deviation
+                return check_value(_NONNEG, value, f, name)
+            raise InputError(f, name, f"expected a table {{ {', '.join(fields)} }} of numbers, got {value!r}"[:200])
+        for k in value:
+            if k not in fields:
+                raise unknown_key(f, name, k, list(fields))
+        return {k: check_value(fields[k], v, f, f"{name}.{k}") for k, v in value.items()}
+    if key in ("range", "update_s"):
+        if not (isinstance(value, list) and len(value) == 2):
+            raise InputError(f, name, f"expected [low, high] (two numbers, low < high), got {value!r}"[:200])
+        lo, hi = (check_value(Spec("num", lo=0.0 if key == "update_s" else None), v, f, f"{name}[{k}]")
+                  for k, v in enumerate(value))
+        if not lo < hi or (key == "update_s" and lo <= 0.0):
+            raise InputError(f, name, f"expected [low, high] with {'0 < ' if key == 'update_s' else ''}low < high, "
+                                      f"got {value!r}")
+        return [lo, hi]
+    return _like(value, catalogue_value, f, name)
+
+
+def _like(value, ref, f: str, name: str):
+    """value checked to have the shape of the catalogue's ref (and its sign, for numbers)."""
+    if isinstance(ref, bool) or isinstance(value, bool):
+        if not (isinstance(ref, bool) and isinstance(value, bool)):
+            raise InputError(f, name, f"expected {'true or false' if isinstance(ref, bool) else 'a number'}, "
+                                      f"got {value!r}"[:200])
+        return value
+    if isinstance(ref, dict):
+        if set(ref) <= {"mean", "sd"} and isinstance(value, (int, float)):  # a distribution: a bare number is its sd
+            return check_value(_NONNEG, value, f, name)
+        if not isinstance(value, dict):
+            raise InputError(f, name, f"expected a table with keys {', '.join(ref)}, got {value!r}"[:200])
+        for k in value:
+            if k not in ref:
+                raise unknown_key(f, name, k, list(ref))
+        return {k: _like(v, ref[k], f, f"{name}.{k}") for k, v in value.items()}
+    if isinstance(ref, list):
+        if not isinstance(value, list) or not value:
+            raise InputError(f, name, f"expected a list of numbers, got {value!r}"[:200])
+        if ref and isinstance(ref[0], (dict, list)):
+            return [_like(v, ref[0], f, f"{name}[{k}]") for k, v in enumerate(value)]
+        return [check_value(Spec("num"), v, f, f"{name}[{k}]") for k, v in enumerate(value)]
+    if isinstance(ref, str):
+        if not isinstance(value, str):
+            raise InputError(f, name, f"expected a string, got {value!r}"[:200])
+        return value
+    leaf = name.rsplit(".", 1)[-1]
+    signed = "bias" in leaf or "mean" in leaf or "offset" in leaf
+    nonneg = not signed and ("noise" in leaf or "sd" in leaf or (isinstance(ref, (int, float)) and ref > 0))
+    return check_value(Spec("num", lo=0.0 if nonneg else None), value, f, name)
 
 
 class InstrumentSet:
@@ -128,7 +203,7 @@ class InstrumentSet:
                     {"rate_hz", "bias", "scale", "gauss_markov", "random_walk", "noise", "resolution", "range",
                      "latency_s", "hold_s", "update_s", "dropout_p", "clock_offset_s", "misalignment_deg"}:
                 raise InputError(f, f"{where}.set.{k}", f"not a parameter of spec {e.spec!r}")
-            spec[k] = val
+            spec[k] = check_setting(k, val, spec.get(k), f, f"{where}.set.{k}")
         kind = spec.get("kind")
         if kind not in KINDS:
             raise InputError(str(CATALOGUE), f"{e.spec}.kind", f"unknown kind {kind!r}")
@@ -136,14 +211,15 @@ class InstrumentSet:
         site = np.zeros(3)
         if e.site is not None:
             if e.site not in v.sites:
-                raise InputError(f, f"{where}.site", f"unknown site {e.site!r} (sites of {v.name}: "
+                raise InputError(f, f"{where}.site", f"unknown site {e.site!r}{did_you_mean(e.site, v.sites)} (sites of {v.name}: "
                                                      f"{', '.join(sorted(v.sites))})")
             site = v.sites[e.site]
         try:
             if issubclass(cls, ShaftDevice):
                 names = [s.name for s in v.shafts]
                 if e.shaft not in names:
-                    raise InputError(f, f"{where}.shaft", f"{e.shaft!r} is not a shaft of {v.name} ({', '.join(names)})")
+                    raise InputError(f, f"{where}.shaft", f"{e.shaft!r} is not a shaft of {v.name}{did_you_mean(e.shaft, names)} "
+                                                          f"({', '.join(names)})")
                 k = names.index(e.shaft)
                 pk = [p.name for p in v.propellers].index(v.shafts[k].propeller)
                 pos = np.array([v.propellers[pk].x, v.propellers[pk].y, v.propellers[pk].z])
@@ -152,7 +228,7 @@ class InstrumentSet:
             if cls is RudderAngle:
                 names = [r.name for r in v.rudders]
                 if e.rudder not in names:
-                    raise InputError(f, f"{where}.rudder", f"{e.rudder!r} is not a rudder of {v.name} "
+                    raise InputError(f, f"{where}.rudder", f"{e.rudder!r} is not a rudder of {v.name}{did_you_mean(e.rudder, names)} "
                                                            f"({', '.join(names)})")
                 k = names.index(e.rudder)
                 rd = v.rudders[k]

@@ -66,6 +66,22 @@ def euler_to_quat(phi: float, theta: float, psi: float) -> np.ndarray:
                      spsi * cth * cphi - cpsi * sth * sphi])
 
 
+_MJ_WARNINGS: list[str] = []  # MuJoCo's last warning texts (kept here, not in ./MUJOCO_LOG.TXT)
+
+
+def _keep_warning(text: str) -> None:
+    _MJ_WARNINGS.append(str(text).strip())
+    del _MJ_WARNINGS[:-10]
+
+
+def _quiet_mujoco() -> None:
+    """Route MuJoCo's warnings to :data:`_MJ_WARNINGS`: its default handler appends them to
+    MUJOCO_LOG.TXT in the working directory. The simulator turns every warning into a
+    :class:`SimulationError` through the warning counters."""
+    if mujoco.get_mju_user_warning() is not _keep_warning:
+        mujoco.set_mju_user_warning(_keep_warning)
+
+
 class Simulator:
     """N ships of one :class:`Vessel`, each with its own environment block.
 
@@ -92,7 +108,18 @@ class Simulator:
         model.opt.timestep = self.dt
         model.opt.gravity[:] = (0.0, 0.0, gravity)
         self.model = model
+        if isinstance(nthread, bool) or not isinstance(nthread, (int, np.integer)) or nthread < 1:
+            from vtrials.errors import InputError
+            raise InputError("Simulator", "nthread", f"expected an integer ≥ 1 (MuJoCo batch threads), got {nthread!r}")
+        if isinstance(n_ships, bool) or not isinstance(n_ships, (int, np.integer)) or n_ships < 1:
+            from vtrials.errors import InputError
+            raise InputError("Simulator", "n_ships", f"expected an integer ≥ 1, got {n_ships!r}")
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and 0.0 < dt <= 1.0):
+            from vtrials.errors import InputError
+            raise InputError("Simulator", "dt", f"expected a time step in (0, 1] s, got {dt!r}")
+        _quiet_mujoco()
         self.batch = mjbatch.Batch(model, self.n, nthread=nthread)
+        self._wcount = self.batch.warning[:, :, 1]  # MuJoCo's warning counters, per ship and warning type
         self.qpos = self.batch.bind("qpos")
         self.qvel = self.batch.bind("qvel")
         self.qfrc = self.batch.bind("qfrc_applied")
@@ -353,8 +380,25 @@ class Simulator:
             nbad = self._call(krec=krec, rec=rec)
             if nbad:
                 self._raise_status()
-            self.batch.step()
+            try:
+                self.batch.step()
+            except mjbatch.SimulationError as exc:
+                self._raise_mujoco(int(exc.ids[0]), str(exc))
+            if self._wcount.any():
+                self._raise_mujoco(int(np.flatnonzero(self._wcount.any(axis=1))[0]), None)
             self._step_count += 1
+
+    def _raise_mujoco(self, i: int, text: str | None):
+        """A MuJoCo warning (its warning counters rose) or error in ship i: stop with the time and state."""
+        if text is None:
+            kinds = [mujoco.mjtWarning(k).name for k in np.flatnonzero(self._wcount[i])]
+            text = f"MuJoCo warning {', '.join(kinds)}" + (f" ({_MJ_WARNINGS[-1]})" if _MJ_WARNINGS else "")
+        q = self.qpos[i]
+        v = self.qvel[i]
+        msg = (f"simulation stopped at t = {self.time[i]:.3f} s (ship {i}): {text}; "
+               f"state: qpos {np.array2string(q, precision=4, max_line_width=10 ** 6)}, "
+               f"qvel {np.array2string(v, precision=4, max_line_width=10 ** 6)}")
+        raise SimulationError(msg, time_s=float(self.time[i]), ship=i)
 
     def check(self) -> None:
         """Check the current states (the kernel checks each state before it is integrated)."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from pathlib import Path
 
 import mujoco
@@ -255,17 +256,34 @@ def available_models() -> list[str]:
 
 def load_vessel(name_or_path: str | Path, *, file_for_errors: str | None = None,
                 field_for_errors: str = "ship") -> Vessel:
-    """Load ``models/<name>/ship.toml`` (or a model folder, or a path to a ship.toml) and its MJCF, checked."""
-    p = Path(name_or_path)
-    if p.suffix == ".toml" and p.is_file():
-        toml_path = p
-    elif p.is_dir() and (p / "ship.toml").is_file():
-        toml_path = p / "ship.toml"
+    """Load a built-in model by name (``models/<name>/ship.toml`` of the package, never a folder of the
+    working directory) or a user's model by an explicit path (a ``Path``, or a string holding a path
+    separator or ending in ``.toml``: a model folder or its ship.toml), with its MJCF, checked."""
+    where = file_for_errors or str(name_or_path)
+    if not isinstance(name_or_path, (str, Path)):
+        raise InputError(where, field_for_errors, f"expected a model name or path, got {name_or_path!r}"[:200])
+    s = str(name_or_path)
+    if "\x00" in s or not s:
+        raise InputError(where, field_for_errors, f"{s!r} is not a model name or path")
+    is_path = isinstance(name_or_path, Path) or "/" in s or os.sep in s or s.endswith(".toml")
+    if is_path:
+        p = Path(name_or_path)
+        if p.suffix == ".toml" and p.is_file():
+            toml_path = p
+        elif p.is_dir() and (p / "ship.toml").is_file():
+            toml_path = p / "ship.toml"
+        else:
+            raise InputError(where, field_for_errors, f"no model at {s!r} (expected a model folder holding "
+                                                      f"ship.toml, or a ship.toml file)")
     else:
-        toml_path = model_dir(str(name_or_path)) / "ship.toml"
-        if not toml_path.is_file():
-            raise InputError(file_for_errors or str(name_or_path), field_for_errors,
-                             f"unknown ship {str(name_or_path)!r} (available: {', '.join(available_models())})")
+        toml_path = model_dir(s) / "ship.toml"
+        if s not in available_models():
+            import difflib
+            close = difflib.get_close_matches(s, available_models(), n=1, cutoff=0.6)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise InputError(where, field_for_errors,
+                             f"unknown ship {s!r}{hint} (built-in models: {', '.join(available_models())}; "
+                             f"a model of your own is given by its path, e.g. ./{s})")
     f = str(toml_path)
     doc = load_toml(toml_path)
     known = list(_SECTIONS) + [v[0] for v in _HULLS.values()] + list(_ARRAYS) + ["resistance", "telegraph", "windage"]

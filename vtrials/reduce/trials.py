@@ -390,16 +390,9 @@ def reduce_log_calibration(rec: Record) -> dict:
     hd = np.array([r["course"] for r in runs])
     vg = np.array([r["vg"].value for r in runs])
     grp = [r["group"] for r in runs]
-    G = len(set(grp))
-    trend = len(runs) - (G + 4) >= 3
-    groups, x, cov, dof, tm, resid = _joint_current_fit(t, hd, vg, grp, trend)
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    U = {g: Estimate(float(x[k]), float(sd[k]), dof) for k, g in enumerate(groups)}
-    cur = {"north": Estimate(float(x[G]), float(sd[G]), dof), "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof),
-           "trend": trend, "t_ref": tm}
-    if trend:
-        cur["north_rate"] = Estimate(float(x[G + 2]), float(sd[G + 2]), dof)
-        cur["east_rate"] = Estimate(float(x[G + 3]), float(sd[G + 3]), dof)
+    vs = np.array([r["vg"].std for r in runs])
+    groups, U, cur, fit, under = resolve_current(t, hd, vg, vs, grp)
+    dof, resid = fit["dof"], fit["residuals"]
     # classic cross-checks per group: the four-leg closed form and the reciprocal-pair shortcut
     classic = {}
     for g in groups:
@@ -444,6 +437,10 @@ def reduce_log_calibration(rec: Record) -> dict:
         if len(gs) < 3:
             calibrations[name] = {"error": f"only {len(gs)} speeds with readings: no regression"}
             continue
+        undet = [g for g in gs if U[g] is None]
+        if undet:
+            calibrations[name] = {"error": f"speed through water under-determined at group(s) {undet}: no regression"}
+            continue
         xr = np.array([np.mean(pts[g]) for g in gs])
         yr = np.array([U[g].value for g in gs])
         ys = np.array([U[g].std for g in gs])
@@ -469,13 +466,91 @@ def reduce_log_calibration(rec: Record) -> dict:
                 per_leg.append({"run": r["run"], "k": sm.k.tolist(),
                                 "std_kn": (np.asarray(sm.std) / window).tolist()})
         smoothing[name] = per_leg
-    return {"kind": "log_calibration", "tracking": runs[0]["tracking"], "legs": legs,
+    out = {"kind": "log_calibration", "tracking": runs[0]["tracking"], "legs": legs,
             "groups": {str(g): _est(U[g]) for g in groups},
             "current": {k: (_est(v) if isinstance(v, Estimate) else v) for k, v in cur.items()},
-            "fit": {"dof": dof, "residual_rms": float(np.sqrt(np.mean(resid ** 2))), "trend": trend},
+            "fit": {"dof": dof, "residual_rms": None if resid is None else float(np.sqrt(np.mean(resid ** 2))),
+                    "trend": fit["trend"]},
             "classic": {str(g): v for g, v in classic.items()}, "calibrations": calibrations,
             "smoothing": smoothing,
             "runs": [{k: v for k, v in r.items() if k not in ("vg", "power")} | {"vg": _est(r["vg"])} for r in runs]}
+    if under:
+        out["under_determined"] = under
+    return out
+
+
+def resolve_current(t, heading, vg, vg_std, group):
+    """Speed through water per group and the current from the legs' ground speeds, or the reason they
+    cannot be resolved.
+
+    The joint least-squares fit (:func:`_joint_current_fit`) has G + 2 unknowns (G + 4 with a linear
+    trend, used when at least 3 legs are left over). It is identified only when there are more legs
+    than unknowns (else no degrees of freedom remain for its uncertainty) and its linearised design
+    [group indicators, cos ψ, sin ψ (, their time-weighted copies)] has full rank: legs all on one
+    axis (reciprocal pairs only) leave the current across that axis unresolved. Then the current is
+    reported as under-determined (``current = {"under_determined": why}``) and each group's speed
+    through water falls back to the classic per-group estimate that needs no current: the mean of a
+    reciprocal pair's ground speeds (the along-axis current cancels; seed 000 eq. 3), or the four-leg
+    closed form (seed 000 App. A); a group with neither is under-determined too.
+
+    Returns (groups, U {group: Estimate | None}, current dict, fit dict, under-determined list).
+    """
+    t, heading, vg, vg_std = (np.asarray(a, dtype=float) for a in (t, heading, vg, vg_std))
+    groups = sorted(set(group))
+    G = len(groups)
+    n = vg.size
+    gi = np.array([groups.index(g) for g in group])
+    tm = float(np.mean(t))
+
+    def design(trend):
+        cols = [(gi == k).astype(float) for k in range(G)] + [np.cos(heading), np.sin(heading)]
+        if trend:
+            tt = (t - tm) / max(float(np.ptp(t)), 1.0)
+            cols += [np.cos(heading) * tt, np.sin(heading) * tt]
+        return np.column_stack(cols)
+
+    trend = n - (G + 4) >= 3 and np.linalg.matrix_rank(design(True)) == G + 4
+    p = G + (4 if trend else 2)
+    rank = int(np.linalg.matrix_rank(design(trend)))
+    if n > p and rank == p:
+        groups, x, cov, dof, tm, resid = _joint_current_fit(t, heading, vg, group, trend)
+        sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        U = {g: Estimate(float(x[k]), float(sd[k]), dof) for k, g in enumerate(groups)}
+        cur = {"north": Estimate(float(x[G]), float(sd[G]), dof),
+               "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof), "trend": trend, "t_ref": tm}
+        if trend:
+            cur["north_rate"] = Estimate(float(x[G + 2]), float(sd[G + 2]), dof)
+            cur["east_rate"] = Estimate(float(x[G + 3]), float(sd[G + 3]), dof)
+        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend}, []
+    if rank < p:
+        axes = sorted({round(math.degrees(h) % 180.0, 1) for h in heading})
+        why = (f"the legs lie on {'one axis' if len(axes) == 1 else 'too few axes'} "
+               f"({', '.join(f'{a:g}°/{a + 180.0:g}°' for a in axes)}): the current across it cannot be "
+               f"resolved (design rank {rank} < {p} unknowns)")
+    else:
+        why = (f"{n} legs for {p} unknowns (a speed per group and the current north and east): no "
+               f"degree of freedom is left to estimate it and its uncertainty")
+    under = [{"quantity": "current", "why": why}]
+    U = {}
+    for k, g in enumerate(groups):
+        sel = gi == k
+        hs = heading[sel]
+        if sel.sum() == 2 and abs(abs(((hs[1] - hs[0] + math.pi) % (2 * math.pi)) - math.pi) - math.pi) < math.radians(5):
+            U[g] = Estimate(float(np.mean(vg[sel])), 0.5 * float(np.hypot(*vg_std[sel])))
+        elif sel.sum() == 4:
+            try:
+                fl = CUR.four_leg_current(*vg[sel], heading0=float(hs[0]), std=list(vg_std[sel]))
+                U[g] = fl.u
+            except ValueError:
+                U[g] = None
+        else:
+            U[g] = None
+        if U[g] is None:
+            under.append({"quantity": f"speed through water of group {g}",
+                          "why": f"{int(sel.sum())} legs that form neither a reciprocal pair nor a four-leg set, "
+                                 f"and the current is not resolved"})
+    return groups, U, {"under_determined": why, "trend": False, "t_ref": tm}, \
+        {"dof": n - p, "residuals": None, "trend": False}, under
 
 
 def reduce_record(rec: Record) -> dict:

@@ -165,6 +165,10 @@ def _lc_figures(tr: dict, out: Path) -> list[str]:
         files.append(_save(fig, out, f))
     fig, ax = plt.subplots(figsize=(9, 3.4))
     t = np.array([leg["t_mid"] for leg in red["legs"]]) / 3600
+    if not err["current"]:  # the current was under-determined: the truth alone
+        ax.plot(t, [leg["true_current"][0] / KNOT for leg in err["legs"]], "k.-", label="true current north")
+        ax.plot(t, [leg["true_current"][1] / KNOT for leg in err["legs"]], "k.--", label="true current east")
+        t = t[:0]
     ax.plot(t, [c["truth"][0] / KNOT for c in err["current"]], "k.-", label="true current north")
     ax.plot(t, [c["truth"][1] / KNOT for c in err["current"]], "k.--", label="true current east")
     ax.plot(t, [c["reduced"][0] / KNOT for c in err["current"]], "C0o", label="reduced north")
@@ -186,6 +190,8 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
          f"{_fmt(sm['max_abs_stw_error_kn'], 3)} kn; 95 % intervals cover the truth on "
          f"{_fmt(_pct(sm['stw_coverage']), 0)} % of legs; current error ≤ "
          f"{_fmt(sm['max_current_error_kn'], 3)} kn.", ""]
+    for u in red.get("under_determined", []):
+        L += [f"**Not reduced — {u['quantity']} is under-determined**: {u['why']}.", ""]
     L += [f"![{f}]({f})" for f in figs] + [""]
     for inst, cal in red["calibrations"].items():
         if "error" in cal:

@@ -18,7 +18,12 @@ def run(scenario_path: str | Path, out_dir: str | Path, nthread: int = 1, plot: 
     """Load, check, simulate and write a scenario. A scenario with an ``[agenda]`` goes through
     :mod:`vtrials.runner.trial_day` (crew, records, reductions, scoring, report); one with
     ``[[maneuver]]`` tables through :mod:`vtrials.runner.side_by_side`."""
+    from vtrials.errors import InputError
+    from vtrials.runner.staging import check_out
+    if isinstance(nthread, bool) or not isinstance(nthread, int) or nthread < 1:
+        raise InputError("run()", "nthread", f"expected an integer ≥ 1 (MuJoCo batch threads), got {nthread!r}")
     scn = load_scenario(scenario_path)
+    check_out(out_dir)  # before simulating
     if scn.agenda is not None:
         from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
         result = simulate_agenda(scn, progress=progress)

@@ -156,7 +156,11 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
                for i, m in enumerate(scn.maneuvers)]
     sup = ProgramSupervisor(scn.maneuvers, vessel, ap, execute_step, max_dur, [10.0 * lu for lu in L_over_U],
                             dt, progress)
-    Driver(sim).run([sup])
+    try:
+        Driver(sim).run([sup])
+    except KeyboardInterrupt as exc:  # the CLI names the trial time it stopped at
+        exc.trial_time_s = float(np.max(sim.time))
+        raise
     t_exec, t_finex, completed = sup.t_exec, sup.t_finex, sup.completed
     sim.check()
     rec = sim.truth()
@@ -213,11 +217,14 @@ def write_truth(result: RunResult, path: Path) -> None:
 
 
 def write_outputs(result: RunResult, out_dir: str | Path, plot: bool = True) -> dict:
-    """Write truth.nc, results.json and trajectory.png into out_dir (each atomically)."""
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InputError(str(out), "--out", "exists and is not a directory")
-    out.mkdir(parents=True, exist_ok=True)
+    """Write truth.nc, results.json and trajectory.png into out_dir: into a staging directory beside it
+    that replaces out_dir only when everything is written (:mod:`vtrials.runner.staging`)."""
+    from vtrials.runner.staging import staged_output
+    with staged_output(out_dir) as out:
+        return _write_outputs(result, out, plot)
+
+
+def _write_outputs(result: RunResult, out: Path, plot: bool) -> dict:
     write_truth(result, out / "truth.nc")
     for i, m in enumerate(result.maneuvers):
         if m.instruments is not None:

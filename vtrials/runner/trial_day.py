@@ -90,15 +90,19 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path))
     iset.reset()
     crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)
-    crew.run_agenda()
-    t_ins = time.perf_counter()
-    iset.flush()
-    crew.instrument_wall_s += time.perf_counter() - t_ins
-    timings["simulate_s"] = time.perf_counter() - t_wall
-    timings["instruments_s"] = crew.instrument_wall_s
-    t1 = time.perf_counter()
-    calm = calm_water_truth(scn, crew)
-    calm.update(spiral_truth(scn, crew))
+    try:
+        crew.run_agenda()
+        t_ins = time.perf_counter()
+        iset.flush()
+        crew.instrument_wall_s += time.perf_counter() - t_ins
+        timings["simulate_s"] = time.perf_counter() - t_wall
+        timings["instruments_s"] = crew.instrument_wall_s
+        t1 = time.perf_counter()
+        calm = calm_water_truth(scn, crew)
+        calm.update(spiral_truth(scn, crew))
+    except KeyboardInterrupt as exc:  # the CLI names the trial time it stopped at
+        exc.trial_time_s = float(crew.t)
+        raise
     timings["calm_water_s"] = time.perf_counter() - t1
     return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings)
 
@@ -265,13 +269,17 @@ def max_speed(vessel, sim: Simulator) -> float:
 
 
 def write_agenda_outputs(res: AgendaResult, out_dir: str | Path, plot: bool = True) -> dict:
+    """Write truth, records, results.json and the report into out_dir: into a staging directory beside
+    it that replaces out_dir only when everything is written (:mod:`vtrials.runner.staging`)."""
+    from vtrials.runner.staging import staged_output
+    with staged_output(out_dir) as out:
+        return _write_agenda_outputs(res, out, plot)
+
+
+def _write_agenda_outputs(res: AgendaResult, out: Path, plot: bool) -> dict:
     from vtrials.reduce.trials import reduce_record
     from vtrials.report.trial_report import write_report
     from vtrials.score.trials import score_trial
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InputError(str(out), "--out", "exists and is not a directory")
-    out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     write_agenda_truth(res, out / "truth.nc")
     paths = write_trial_records(res, out)

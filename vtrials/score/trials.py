@@ -123,7 +123,7 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
     cur = reduced["current"]
     tref = cur["t_ref"]
     cur_err = []
-    for leg in reduced["legs"]:
+    for leg in ([] if "under_determined" in cur else reduced["legs"]):  # an unresolved current has no error
         tr = truth[leg["run"]]
         cn = cur["north"]["value"] + (cur["north_rate"]["value"] * (leg["t_mid"] - tref) if cur["trend"] else 0.0)
         ce = cur["east"]["value"] + (cur["east_rate"]["value"] * (leg["t_mid"] - tref) if cur["trend"] else 0.0)
@@ -145,7 +145,7 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
     errs = [abs(x["stw_error_kn"]) for x in legs if x["stw_error_kn"] is not None]
     summary = {"legs": len(legs), "max_abs_stw_error_kn": max(errs) if errs else None,
                "stw_coverage": sum(cover) / len(cover) if cover else None,
-               "max_current_error_kn": max(c["error_mps"] for c in cur_err) / KNOT}
+               "max_current_error_kn": max(c["error_mps"] for c in cur_err) / KNOT if cur_err else None}
     return {"reduced": reduced, "truth": {"legs": [truth[x["run"]] for x in reduced["legs"]]},
             "error": {"summary": summary, "legs": legs, "current": cur_err, "calibrations": cals}}
 

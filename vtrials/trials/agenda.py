@@ -24,7 +24,8 @@ import dataclasses
 import math
 
 from vtrials.errors import InputError
-from vtrials.schema import flag, integer, num, read_table, text, unknown_key, vector
+from vtrials.schema import (did_you_mean, check_name, choice, flag, integer, num, read_table, table, table_list, text, unknown_key,
+                            vector)
 from vtrials.units import DEG, RPM
 
 ORDERS = ("ahead_1_3", "ahead_2_3", "standard", "full", "flank")
@@ -208,7 +209,7 @@ def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None,
     cp = any(sh.controllable_pitch for sh in vessel.shafts)
     if s.order is not None:
         if s.order not in vessel.telegraph:
-            raise InputError(f, f"{sec}.order", f"{vessel.name} has no telegraph position {s.order!r} (it has "
+            raise InputError(f, f"{sec}.order", f"{vessel.name} has no telegraph position {s.order!r}{did_you_mean(s.order, vessel.telegraph)} (it has "
                                                 f"{', '.join(vessel.telegraph)})")
         rps, pitch = vessel.telegraph[s.order]
         if s.pitch is not None:
@@ -235,7 +236,7 @@ def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None,
         if val is None:
             continue
         if val not in names:
-            raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r} (shafts of {vessel.name}: "
+            raise InputError(f, f"{sec}.{field}", f"unknown shaft {val!r}{did_you_mean(val, names)} (shafts of {vessel.name}: "
                                                   f"{', '.join(names)})")
         if modes[names.index(val)] != "governed":
             raise InputError(f, f"{sec}.{field}", "a shaft cannot be trailed and locked at once")
@@ -257,11 +258,12 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
         raise InputError(f, "agenda", "expected a table")
     doc = dict(doc)
     trials_tab = doc.pop("trial", None)
-    st_tab = doc.pop("steadiness", {})
+    st_tab = table(doc.pop("steadiness", None), f, "agenda.steadiness")
     rules, _ = read_table(AgendaRules, doc, f, "agenda")
     steadiness, _ = read_table(Steadiness, st_tab, f, "agenda.steadiness")
     if not isinstance(trials_tab, list) or not trials_tab:
         raise InputError(f, "agenda.trial", "expected at least one [[agenda.trial]] table")
+    table_list(trials_tab, f, "agenda.trial")
     trials = []
     number = 0
     names = set()
@@ -272,9 +274,9 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
         sec = f"agenda.trial[{it}]"
         if not isinstance(tab, dict):
             raise InputError(f, sec, "expected a table")
-        kind = tab.get("kind")
-        if kind not in _ITEMS:
-            raise InputError(f, f"{sec}.kind", f"unknown trial kind {kind!r} (allowed: {', '.join(_ITEMS)})")
+        kind = choice(tab.get("kind"), _ITEMS, f, f"{sec}.kind", "trial kind")
+        if "name" in tab:
+            check_name(tab["name"], f, f"{sec}.name")
         item_key, item_cls = _ITEMS[kind]
         tab = dict(tab)
         items = tab.pop(item_key, None)
@@ -296,6 +298,7 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
                                                                f"of {vessel.name} ({max_rudder:g}°)")
         if not isinstance(items, list) or not items:
             raise InputError(f, f"{sec}.{item_key}", f"expected at least one [[agenda.trial.{item_key}]] table")
+        table_list(items, f, f"{sec}.{item_key}")
         runs = []
         for ii, itab in enumerate(items):
             isec = f"{sec}.{item_key}[{ii}]"
@@ -365,7 +368,8 @@ def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pit
             raise InputError(f, f"{sec}.to_order", "a speed_change needs to_order or to_rpm (not both)")
         if m.to_order is not None:
             if m.to_order not in vessel.telegraph:
-                raise InputError(f, f"{sec}.to_order", f"{vessel.name} has no telegraph position {m.to_order!r}")
+                raise InputError(f, f"{sec}.to_order", f"{vessel.name} has no telegraph position {m.to_order!r}"
+                                                      f"{did_you_mean(m.to_order, vessel.telegraph)}")
             p["to_rps"], p["to_pitch"] = vessel.telegraph[m.to_order]
             p["to_order"] = m.to_order
         else:
