@@ -388,17 +388,31 @@ def _mv_markdown(tr: dict, figs: list[str]) -> list[str]:
     if imo.get("verdicts"):
         L += [f"IMO MSC.137(76) (L = {imo['length_m']:.1f} m, V = {imo['speed_mps'] / KNOT:.2f} kn):", "",
               "| criterion | value | limit | passed | margin | true value | true verdict |", "|---|---|---|---|---|---|---|"]
-        truth = tr["truth"].get("imo") or {}
-        for k, v in imo["verdicts"].items():
-            if not isinstance(v, dict) or "limit" not in v:
-                continue
-            tv = truth.get(k, {}) if isinstance(truth, dict) else {}
-            val = v["value"]["value"] if isinstance(v["value"], dict) else v["value"]
-            tval = tv.get("value", {}).get("value") if isinstance(tv.get("value"), dict) else tv.get("value")
-            L.append(f"| {v['criterion']} | {_fmt(val, 3)} | {_fmt(v['limit'], 3)} | {v['passed']} | "
-                     f"{_fmt(v.get('margin'), 3)} | {_fmt(tval, 3)} | {tv.get('passed')} |")
+        L += imo_rows(imo["verdicts"], tr["truth"].get("imo") or {})
         L.append("")
     return L
+
+
+def imo_rows(verdicts: dict, truth: dict) -> list[str]:
+    """Markdown rows of the IMO verdict table; angles (kept in rad inside) are printed in degrees,
+    the unit the MSC.137(76) criteria are written in, and every value carries its unit."""
+    rows = []
+    for k, v in verdicts.items():
+        if not isinstance(v, dict) or "limit" not in v:
+            continue
+        tv = truth.get(k, {}) if isinstance(truth, dict) else {}
+        f, unit = (180.0 / math.pi, "°") if v.get("unit") == "rad" else (1.0, f" {v.get('unit')}" if v.get("unit") else "")
+
+        def num(x):
+            x = x.get("value") if isinstance(x, dict) else x
+            return None if x is None else x * f
+
+        def show(x):
+            x = num(x)
+            return "–" if x is None else f"{_fmt(x, 2)}{unit}"
+        rows.append(f"| {v['criterion']} | {show(v['value'])} | {show(v['limit'])} | {v['passed']} | "
+                    f"{show(v.get('margin'))} | {show(tv.get('value'))} | {tv.get('passed')} |")
+    return rows
 
 
 # ----------------------------------------------------------------------------------- the document
