@@ -359,30 +359,63 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
 
 
 def direct_power_method(p_ms, delta_r, v_s, eta_d_id, eta_d_ms=None, p_ms_std=None,
-                        delta_r_std=None):
-    """Corrected power by the Direct Power Method (ITTC 7.5-04-01-01.1 (2017); ISO 15016:2015):
+                        delta_r_std=None, xi_p=None):
+    """Corrected power by the Direct Power Method (ITTC 7.5-04-01-01.1 (2017, rev. 2021) §"Direct
+    Power Method"; ISO 15016:2015):
 
         P_D,id = P_D,ms − ΔR V_S/η_D,id − P_D,ms (1 − η_D,ms/η_D,id)
 
     p_ms [W] measured delivered power, delta_r [N] total resistance increase (wind + waves + …),
     v_s [m/s] speed through water, eta_d_id propulsive efficiency in the ideal condition (from the
-    model tests), eta_d_ms in the trial condition. With eta_d_ms None the third term is dropped
-    (η_D,ms = η_D,id: the simple form P_id = P_ms − ΔR V_S/η_D). The standard obtains η_D,ms from
-    the load-variation test (overload factor ξ_P); that relation is not coded here — pass eta_d_ms.
+    model tests), eta_d_ms in the trial condition. The standard takes η_D,ms from the overload factor
+    ξ_P of the load-variation test (:func:`overload_factor`),
 
-    Returns (p_id, std) arrays; std from p_ms_std [W] and delta_r_std [N] (independent).
+        η_D,ms = η_D,id / (1 + ξ_P (P_D,ms − P_D,id)/P_D,id),
+
+    which is implicit in P_D,id and solved here by fixed-point iteration when ``xi_p`` is given. With
+    neither eta_d_ms nor xi_p the third term is dropped (η_D,ms = η_D,id, the simple form
+    P_id = P_ms − ΔR V_S/η_D) — which overstates the corrected power when the propeller is overloaded.
+
+    Returns (p_id, std) arrays; std from p_ms_std [W] and delta_r_std [N] (independent; the small
+    dependence of η_D,ms on the data is not propagated).
     """
     p_ms = np.asarray(p_ms, dtype=float)
     dr = np.asarray(delta_r, dtype=float)
     v_s = np.asarray(v_s, dtype=float)
-    ratio = 1.0 if eta_d_ms is None else np.asarray(eta_d_ms, dtype=float) / eta_d_id
-    p_id = p_ms - dr * v_s / eta_d_id - p_ms * (1.0 - ratio)
+    if xi_p is not None:
+        if eta_d_ms is not None:
+            raise ValueError("give eta_d_ms or xi_p, not both")
+        xi = np.asarray(xi_p, dtype=float)
+        p_id = p_ms - dr * v_s / eta_d_id
+        for _ in range(100):
+            ratio = 1.0 / (1.0 + xi * (p_ms - p_id) / p_id)  # η_D,ms / η_D,id
+            new = p_ms - dr * v_s / eta_d_id - p_ms * (1.0 - ratio)
+            if np.all(np.abs(new - p_id) <= 1e-12 * np.abs(p_ms)):
+                p_id = new
+                break
+            p_id = new
+        ratio = 1.0 / (1.0 + xi * (p_ms - p_id) / p_id)
+    else:
+        ratio = 1.0 if eta_d_ms is None else np.asarray(eta_d_ms, dtype=float) / eta_d_id
+        p_id = p_ms - dr * v_s / eta_d_id - p_ms * (1.0 - ratio)
     var = np.zeros(np.broadcast(p_ms, dr, v_s).shape)
     if p_ms_std is not None:
         var = var + (np.asarray(ratio) * np.asarray(p_ms_std, dtype=float)) ** 2
     if delta_r_std is not None:
         var = var + (v_s / eta_d_id * np.asarray(delta_r_std, dtype=float)) ** 2
     return p_id, np.sqrt(var)
+
+
+def overload_factor(p_d, eta_d, p_d_id, eta_d_id) -> float:
+    """Overload factor ξ_P from a load-variation test at one speed (ITTC 7.5-04-01-01.1 (2017, rev.
+    2021); ISO 15016:2015): the least-squares slope through the origin of η_D,id/η_D − 1 against
+    (P_D − P_D,id)/P_D,id over the test's loadings, the relation the Direct Power Method uses
+    (:func:`direct_power_method`). p_d [W], eta_d [–] per loading; p_d_id, eta_d_id at zero added load."""
+    x = (np.asarray(p_d, dtype=float) - p_d_id) / p_d_id
+    y = eta_d_id / np.asarray(eta_d, dtype=float) - 1.0
+    if x.size < 1 or not np.any(x != 0):
+        raise ValueError("the load-variation test needs at least one loading that changes the power")
+    return float(x @ y / (x @ x))
 
 
 def displacement_correction(power, disp_trial, disp_target, power_std=None):

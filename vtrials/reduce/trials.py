@@ -196,6 +196,13 @@ def _eta_d(tank: dict, v):
     return np.interp(v, tank["speed_mps"], tank["eta_D"])
 
 
+def _xi_p(tank: dict, v):
+    """Overload factor ξ_P of the tank's load-variation test at speed v (None if the tank did none)."""
+    if not tank or not tank.get("xi_P"):
+        return None
+    return float(np.interp(v, tank["speed_mps"], tank["xi_P"]))
+
+
 # ----------------------------------------------------------------------------------- standardization
 def reduce_standardization(rec: Record) -> dict:
     team = rec.team
@@ -251,9 +258,10 @@ def reduce_standardization(rec: Record) -> dict:
             wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
                          for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
         eta = _eta_d(tank, vs.value)
+        xi = _xi_p(tank, vs.value)
         if eta is not None:
             p_id, p_id_se = SP.direct_power_method(p_ms, d_r, vs.value, float(eta), p_ms_std=p_ms_se,
-                                                   delta_r_std=d_r_se)
+                                                   delta_r_std=d_r_se, xi_p=xi)
         else:
             p_id, p_id_se = p_ms, p_ms_se
         # run-to-run power scatter at equal settings (gusts, helm) as seen after the correction
@@ -277,7 +285,7 @@ def reduce_standardization(rec: Record) -> dict:
                       "stw": _est(vs), "power_measured": _est(P_ms), "power": _est(P),
                       "rps": rps.value, "torque": torque, "thrust": thrust,
                       "current_along_base": current_along, "wind": wind_used,
-                      "eta_D": None if eta is None else float(eta),
+                      "eta_D": None if eta is None else float(eta), "xi_P": xi,
                       "steady": all(r["steady"] for r in rs)})
     _two_run_trend_correction(spots, runs)
     # the faired speed–power curve: monotone cubic through the spots in log–log (trial practice fairs
