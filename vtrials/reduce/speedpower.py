@@ -22,6 +22,10 @@ from scipy import optimize, stats
 from vtrials.reduce.estimate import Estimate
 
 RHO_AIR = 1.225  # [kg/m³] ISA sea-level air density; pass the measured value when known
+# power-law exponent of the true wind's height profile: 1/9 in ITTC 7.5-04-01-01.1 (2017, rev. 2021)
+# §"Resistance increase due to wind" and in ISO 15016:2015 (harmonised with it); the simulated mean
+# wind uses the same (vtrials.physics.environment.wind.TRIALS_PROFILE_EXPONENT)
+WIND_PROFILE_EXPONENT = 1.0 / 9.0
 
 
 # ==================================================================================================
@@ -307,10 +311,48 @@ class WindResistance:
     psi_wt: np.ndarray
 
 
-def _r_aa(v_wr, psi_wr, v_g, cx, a_xv, rho_a, z_a, z_ref):
+def average_true_wind(v_wt, psi_wt, heading):
+    """True wind averaged as a vector over a double run (ITTC 7.5-04-01-01.1 (2017) §"wind": the true
+    wind vectors of the runs of a pair are averaged, then each run's relative wind is recomposed from
+    the mean true wind and that run's heading and speed). v_wt [m/s], psi_wt [rad, from-direction off
+    the bow], heading [rad] per run; returns per run (v_wt, psi_wt) of the mean true wind."""
+    v_wt = np.asarray(v_wt, dtype=float)
+    d = np.asarray(psi_wt, dtype=float) + np.asarray(heading, dtype=float)  # from-direction off north
+    x, y = float(np.mean(v_wt * np.cos(d))), float(np.mean(v_wt * np.sin(d)))
+    mean_dir = math.atan2(y, x)
+    psi = np.arctan2(np.sin(mean_dir - heading), np.cos(mean_dir - heading))
+    return np.full_like(v_wt, math.hypot(x, y)), psi
+
+
+def correct_airwake(speed, angle, speed_coef, direction_coef):
+    """Undo a mast anemometer's airwake calibration: the site reads U_m = U (1 + a₀ + Σ aₖ cos kγ +
+    bₖ sin kγ) at γ_m = γ + c₀ + Σ cₖ sin kγ (γ the undisturbed relative wind angle; coefficients from
+    the ship's airwake survey or model test, ITTC 7.5-04-01-01.1 (2017) §"wind": the anemometer
+    reading is corrected for the ship's own airwake). speed_coef = [a₀, a₁, b₁, a₂, b₂, …],
+    direction_coef = [c₀, c₁, …] [rad]. Returns the undisturbed (speed, angle), γ by fixed point."""
+    sp = np.asarray(speed, dtype=float)
+    gm = np.asarray(angle, dtype=float)
+    ws = np.asarray(speed_coef, dtype=float)
+    wd = np.asarray(direction_coef, dtype=float)
+
+    def off(g):
+        return wd[0] + sum(wd[i] * np.sin(i * g) for i in range(1, wd.size)) if wd.size else 0.0 * g
+
+    g = gm.copy()
+    for _ in range(60):
+        g = gm - off(g)
+    k = (ws.size - 1) // 2
+    fac = 1.0 + (ws[0] if ws.size else 0.0) + sum(ws[2 * i - 1] * np.cos(i * g) + ws[2 * i] * np.sin(i * g)
+                                                  for i in range(1, k + 1))
+    return sp / fac, g
+
+
+def _r_aa(v_wr, psi_wr, v_g, cx, a_xv, rho_a, z_a, z_ref, heading=None):
     v_wt, psi_wt = true_wind(v_wr, psi_wr, v_g)
-    if z_a is not None:
-        v_wt_ref = v_wt * (z_ref / z_a) ** (1.0 / 9.0)
+    if heading is not None:
+        v_wt, psi_wt = average_true_wind(v_wt, psi_wt, heading)
+    if z_a is not None or heading is not None:
+        v_wt_ref = v_wt if z_a is None else v_wt * (z_ref / z_a) ** WIND_PROFILE_EXPONENT
         v_wr_ref, psi_wr_ref = relative_wind(v_wt_ref, psi_wt, v_g)
     else:
         v_wr_ref, psi_wr_ref = np.asarray(v_wr, float), np.asarray(psi_wr, float)
@@ -320,7 +362,7 @@ def _r_aa(v_wr, psi_wr, v_g, cx, a_xv, rho_a, z_a, z_ref):
 
 
 def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anemometer=None,
-                    z_ref=10.0, v_wr_std=None, psi_wr_std=None, cx_rel_std=0.0) -> WindResistance:
+                    z_ref=10.0, v_wr_std=None, psi_wr_std=None, cx_rel_std=0.0, heading=None) -> WindResistance:
     """Resistance increase due to wind (ITTC 7.5-04-01-01.1 (2017) eq. for R_AA; ISO 15016:2015):
 
         R_AA = ½ ρ_A C_X(ψ_WR,ref) A_XV V_WR,ref² − ½ ρ_A C_X(0) A_XV V_G²
@@ -331,8 +373,10 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
     cx(ψ) the ship's wind resistance coefficient (positive = resistance, i.e. −C_X of the usual
     body-axis force convention), a_xv [m²] transverse projected area above the waterline, rho_a
     [kg/m³]. If z_anemometer [m] is given, the true wind is brought to the reference height z_ref of
-    the coefficients by the 1/9 power law V_WT,ref = V_WT (z_ref/z_a)^{1/9} (ITTC 2017) and the relative
-    wind is recomposed; otherwise the measured relative wind is used as is.
+    the coefficients by the 1/9 power law V_WT,ref = V_WT (z_ref/z_a)^{1/9} (ITTC 2017; ISO 15016:2015)
+    and the relative wind is recomposed; otherwise the measured relative wind is used as is. With
+    ``heading`` [rad] per run (the runs of one double run), the true wind vectors are averaged over
+    the runs first (:func:`average_true_wind`, ITTC 2017).
 
     Uncertainty: v_wr_std [m/s], psi_wr_std [rad] propagated by central differences, plus a relative
     uncertainty cx_rel_std of the coefficient (applied to the first term).
@@ -340,7 +384,7 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
     v_wr = np.atleast_1d(np.asarray(v_wr, dtype=float))
     psi_wr = np.atleast_1d(np.asarray(psi_wr, dtype=float))
     v_g = np.atleast_1d(np.asarray(v_g, dtype=float))
-    args = (cx, a_xv, rho_a, z_anemometer, z_ref)
+    args = (cx, a_xv, rho_a, z_anemometer, z_ref, None if heading is None else np.atleast_1d(np.asarray(heading, float)))
     r, vr_ref, pr_ref, vwt, pwt = _r_aa(v_wr, psi_wr, v_g, *args)
     var = np.zeros_like(r)
     if v_wr_std is not None:

@@ -150,8 +150,12 @@ def run_statistics(rec: Record, run: dict) -> dict:
         ts, sp = rec.channel(a, "speed")
         _, an = rec.channel(a, "angle")
         w = (ts >= t0) & (ts <= t1)
-        vx = float(np.mean(sp[w] * np.cos(an[w])))
-        vy = float(np.mean(sp[w] * np.sin(an[w])))
+        sp, an = sp[w], an[w]
+        m = rec.meta(a)
+        if m.get("airwake_speed") is not None:  # the mast's airwake, known from its survey: removed
+            sp, an = SP.correct_airwake(sp, an, m["airwake_speed"], m.get("airwake_direction_rad", [0.0]))
+        vx = float(np.mean(sp * np.cos(an)))
+        vy = float(np.mean(sp * np.sin(an)))
         out["wind"] = {"instrument": a, "speed": math.hypot(vx, vy), "angle": math.atan2(vy, vx),
                        "speed_se": channels[a]["speed"]["se"] if channels[a]["speed"] else math.nan,
                        "height_m": -float(rec.meta(a)["surveyed_position_m"][2])}
@@ -253,7 +257,8 @@ def reduce_standardization(rec: Record) -> dict:
             cx, a_xv = windinfo
             wr = SP.wind_resistance([r["wind"]["speed"] for r in rs], [r["wind"]["angle"] for r in rs], v, cx,
                                     a_xv, rho_air, z_anemometer=rs[0]["wind"]["height_m"], z_ref=10.0,
-                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=0.05)
+                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=0.05,
+                                    heading=[r["course"] for r in rs] if n > 1 else None)
             d_r, d_r_se = wr.r_aa, wr.std
             wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
                          for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
