@@ -415,18 +415,31 @@ def imo_rows(verdicts: dict, truth: dict) -> list[str]:
     return rows
 
 
+def unsteady_reasons(attempt: dict) -> str:
+    """Why the director found an attempt unsteady (empty when steady): the approach's and the run's
+    reasons from the log sheet, each once, so the reader sees why each repeat happened."""
+    if attempt.get("approach_steady") and attempt.get("run_steady"):
+        return ""
+    parts = []
+    for key, where in (("approach_notes", "approach"), ("run_notes", "run")):
+        for n in dict.fromkeys(attempt.get(key) or []):
+            parts.append(f"{where}: {n}")
+    return "; ".join(parts).replace("|", "/") or "unsteady"
+
+
 # ----------------------------------------------------------------------------------- the document
 def write_report(doc: dict, res, out: Path) -> None:
     """report.md and its figures for an agenda run (``doc`` is results.json's content)."""
     L = [f"# {doc['scenario']}", "",
          f"Ship `{doc['ship']}` · seed {doc['seed']} · time step {doc['timestep_s']} s · trial time "
          f"{doc['agenda']['total_time_s'] / 3600:.2f} h · wall time {doc['wall_time_s']:.1f} s", "",
-         "## Agenda", "", "| run | trial | label | course | COMEX | FINEX | run time [min] | steady | accepted |",
-         "|---|---|---|---|---|---|---|---|---|"]
+         "## Agenda", "", "| run | trial | label | course | COMEX | FINEX | run time [min] | steady | accepted | "
+         "why unsteady (the director's judgement) |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
     for a in doc["agenda"]["runs"]:
         L.append(f"| {a['run']}{'' if a['attempt'] == 1 else ' (repeat)'} | {a['trial']} | {a['label']} | "
                  f"{a['course_deg']:.0f}° | {_clock(a['t_comex'])} | {_clock(a['t_finex'])} | {a['elapsed_s'] / 60:.1f} | "
-                 f"{a['approach_steady'] and a['run_steady']} | {a['accepted']} |")
+                 f"{a['approach_steady'] and a['run_steady']} | {a['accepted']} | {unsteady_reasons(a)} |")
     L += ["", "Elapsed trial time per trial: " + ", ".join(f"{k} {v / 3600:.2f} h" for k, v in
                                                             doc["agenda"]["trial_time_s"].items()), ""]
     for tr in doc["trials"]:
