@@ -107,6 +107,14 @@ def run_statistics(rec: Record, run: dict) -> dict:
     out["tracking"] = primary
     s = out["sog"][primary]["sog"]
     out["vg"] = Estimate(s["value"], s["std"], s["dof"])
+    if out["sog"][primary].get("kind") != "loran":  # the run's residual acceleration along its track
+        t, n = rec.channel(primary, "north")
+        _, e = rec.channel(primary, "east")
+        try:
+            a, a_se = SP.along_track_acceleration(t, n, e, t0, t1)
+            out["accel"] = {"value": a, "std": a_se}
+        except ValueError:
+            pass
     # shafts: power from the torque and r/min meters, net thrust, indicated pitch
     shafts = {}
     for name in kinds.get("shaft_torque", []):
@@ -217,6 +225,8 @@ def reduce_standardization(rec: Record) -> dict:
     tank = rec.attr("tank_prediction", {})
     windinfo = _wind_cx(team)
     rho_air = 1.225
+    disp = (rec.attr("condition", {}) or {}).get("displacement_m3") or team.get("displacement_m3")
+    rho_w = float(team.get("water_density", 1025.0))
     # all-runs ITTC iterative analysis (tidal current model when the runs allow it): its residual
     # scatter is the run-to-run variability the per-spot eliminations cannot see
     tt = np.array([r["t_mid"] for r in runs])
@@ -262,6 +272,12 @@ def reduce_standardization(rec: Record) -> dict:
             d_r, d_r_se = wr.r_aa, wr.std
             wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
                          for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
+        # the runs' residual acceleration (SP.acceleration_resistance): inertia is not calm-water power
+        r_acc = np.zeros(n)
+        if disp and all("accel" in r for r in rs):
+            r_acc, r_acc_se = SP.acceleration_resistance([r["accel"]["value"] for r in rs], disp, rho_w,
+                                                         accel_std=[r["accel"]["std"] for r in rs])
+            d_r, d_r_se = d_r + r_acc, np.hypot(d_r_se, r_acc_se)
         eta = _eta_d(tank, vs.value)
         xi = _xi_p(tank, vs.value)
         if eta is not None:
@@ -291,6 +307,7 @@ def reduce_standardization(rec: Record) -> dict:
                       "rps": rps.value, "torque": torque, "thrust": thrust,
                       "current_along_base": current_along, "wind": wind_used,
                       "eta_D": None if eta is None else float(eta), "xi_P": xi,
+                      "r_acc": [float(x) for x in np.atleast_1d(r_acc)],
                       "steady": all(r["steady"] for r in rs)})
     _two_run_trend_correction(spots, runs)
     # the faired speed–power curve: monotone cubic through the spots in log–log (trial practice fairs

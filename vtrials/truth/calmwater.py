@@ -113,7 +113,8 @@ def load_variation(vessel, speeds, fractions=(-0.1, 0.1, 0.2, 0.3, 0.4), sim: Si
 
     sim = sim or Simulator(vessel, 1, 0.05, record_every=0)
     hull = [i for i, n in enumerate(sim.comp_names) if n.startswith("hull")]
-    n_hi = float(np.max([sh.max_rps for sh in vessel.shafts]))
+    # a model propeller in the tank is not held to the engine's limit: search up to 3 × the rated speed
+    n_hi = 3.0 * float(np.max([sh.max_rps for sh in vessel.shafts]))
     out = {"speed_mps": [], "xi_P": [], "points": []}
     for V in speeds:
         s = sim.self_propulsion(0, float(V))
