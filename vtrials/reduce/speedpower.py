@@ -20,6 +20,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from vtrials.reduce.estimate import Estimate
+from vtrials.reduce.runstats import sandwich_variance
 
 RHO_AIR = 1.225  # [kg/m³] ISA sea-level air density; pass the measured value when known
 # power-law exponent of the true wind's height profile: 1/9 in ITTC 7.5-04-01-01.1 (2017, rev. 2021)
@@ -470,15 +471,22 @@ def acceleration_resistance(accel, displacement_m3, rho_water=1025.0, added_mass
     R_acc to the resistance increase removes it in the Direct Power Method. This is a correction beyond
     ITTC 7.5-04-01-01.1 (2017), which asks for steady runs instead. Default m_x/m = 0.08: KVLCC2's
     m′_x/m′ = 0.022/0.274 (Yasukawa & Yoshimura 2015, J. Mar. Sci. Technol. 20:37–52, Table 3).
+    An acceleration the fixes do not resolve (|a| < 2 std) is taken as zero: only a resolved trend is
+    corrected, as only a significant trend makes the director call a run unsteady.
     Returns (R_acc, std)."""
     m = rho_water * float(displacement_m3) * (1.0 + added_mass_fraction)
+    if accel_std is not None:
+        accel = np.where(np.abs(np.asarray(accel, float)) > 2.0 * np.asarray(accel_std, float), accel, 0.0)
     a = np.asarray(accel, dtype=float)
     return m * a, (np.zeros_like(a) if accel_std is None else m * np.asarray(accel_std, dtype=float))
 
 
 def along_track_acceleration(t, north, east, t0=None, t1=None):
     """Mean acceleration along the track [m/s²] in [t0, t1] and its standard error: least-squares
-    quadratic s(t) = s₀ + v t + ½ a t² of the along-track distance (projected on the mean course)."""
+    quadratic s(t) = s₀ + v t + ½ a t² of the along-track distance (projected on the mean course);
+    the standard error allows for correlated fix errors (sandwich variance of the residuals,
+    :func:`vtrials.reduce.runstats.sandwich_variance`)."""
+
     t = np.asarray(t, dtype=float)
     w = np.isfinite(t) & np.isfinite(north) & np.isfinite(east)
     if t0 is not None:
@@ -493,10 +501,11 @@ def along_track_acceleration(t, north, east, t0=None, t1=None):
     c = math.atan2(ve, vn)
     s = n * math.cos(c) + e * math.sin(c)
     X = np.column_stack([np.ones_like(tc), tc, 0.5 * tc ** 2])
-    beta, *_ = np.linalg.lstsq(X, s, rcond=None)
+    P = np.linalg.pinv(X)
+    beta = P @ s
     r = s - X @ beta
-    cov = np.linalg.pinv(X.T @ X) * float(r @ r) / max(t.size - 3, 1)
-    return float(beta[2]), float(math.sqrt(max(cov[2, 2], 0.0)))
+    var, _ = sandwich_variance(P[2], r)
+    return float(beta[2]), float(math.sqrt(max(var * t.size / max(t.size - 3, 1), 0.0)))
 
 
 def displacement_correction(power, disp_trial, disp_target, power_std=None):
