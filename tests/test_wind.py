@@ -46,8 +46,8 @@ def test_mean_profile_power_law():
     z = np.array([2.0, 5.0, 20.0, 50.0])
     u = W.mean_wind_at_height(12.0, z)
     slope = np.diff(np.log(u)) / np.diff(np.log(z))
-    np.testing.assert_allclose(slope, 1.0 / 7.0, rtol=1e-12)  # ISO 15016:2015 exponent by default
-    assert W.mean_wind_at_height(12.0, 40.0, exponent=1 / 9) < W.mean_wind_at_height(12.0, 40.0)
+    np.testing.assert_allclose(slope, 1.0 / 9.0, rtol=1e-12)  # ITTC 2017 / ISO 15016:2015 exponent by default
+    assert W.mean_wind_at_height(12.0, 40.0, exponent=1 / 7) > W.mean_wind_at_height(12.0, 40.0)
     with pytest.raises(ValueError):
         W.mean_wind_at_height(12.0, 0.0)
 

@@ -600,7 +600,9 @@ class Anemometer(Device):
 
     def meta(self):
         m = super().meta()
-        m.update({"distance_constant_m": self.dc, "start_threshold_mps": self.start})
+        # with the mast's airwake survey (model test / CFD / survey runs), which the team corrects for
+        m.update({"distance_constant_m": self.dc, "start_threshold_mps": self.start,
+                  "airwake_speed": self.ws.tolist(), "airwake_direction_rad": self.wd.tolist()})
         return m
 
 

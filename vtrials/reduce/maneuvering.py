@@ -465,13 +465,19 @@ def imo_verdicts(out_runs: list[dict], log: list[dict], L: float) -> dict:
     zz20 = [d for d in out_runs if d["type"] == "zigzag" and d.get("first_overshoot")
             and abs(abs(d["rudder_ordered"]) - math.radians(20.0)) < 1e-6]
     if zz10:
+        # each criterion is judged on its own worst case (MSC/Circ.1053 §4.3.2: the standard applies to
+        # every run), so the first and the second overshoot may come from different runs
         worst = max(zz10, key=lambda d: d["first_overshoot"]["value"])
         kw["first_overshoot_10_rad"] = est(worst["first_overshoot"])
-        if worst.get("second_overshoot"):
-            kw["second_overshoot_10_rad"] = est(worst["second_overshoot"])
-        if worst.get("initial_turning_time") and worst.get("approach_sog"):
-            it = worst["initial_turning_time"]
-            kw["initial_turning_m"] = Estimate(it["value"] * worst["approach_sog"], it["std"] * worst["approach_sog"])
+        second = [d for d in zz10 if d.get("second_overshoot")]
+        if second:
+            kw["second_overshoot_10_rad"] = est(max(second, key=lambda d: d["second_overshoot"]["value"])
+                                                ["second_overshoot"])
+        init = [d for d in zz10 if d.get("initial_turning_time") and d.get("approach_sog")]
+        if init:
+            w = max(init, key=lambda d: d["initial_turning_time"]["value"] * d["approach_sog"])
+            it = w["initial_turning_time"]
+            kw["initial_turning_m"] = Estimate(it["value"] * w["approach_sog"], it["std"] * w["approach_sog"])
         speeds += [d["approach_sog"] for d in zz10 if d.get("approach_sog")]
     if zz20:
         kw["first_overshoot_20_rad"] = est(max(zz20, key=lambda d: d["first_overshoot"]["value"])["first_overshoot"])

@@ -20,8 +20,13 @@ import numpy as np
 from scipy import optimize, stats
 
 from vtrials.reduce.estimate import Estimate
+from vtrials.reduce.runstats import sandwich_variance
 
 RHO_AIR = 1.225  # [kg/m³] ISA sea-level air density; pass the measured value when known
+# power-law exponent of the true wind's height profile: 1/9 in ITTC 7.5-04-01-01.1 (2017, rev. 2021)
+# §"Resistance increase due to wind" and in ISO 15016:2015 (harmonised with it); the simulated mean
+# wind uses the same (vtrials.physics.environment.wind.TRIALS_PROFILE_EXPONENT)
+WIND_PROFILE_EXPONENT = 1.0 / 9.0
 
 
 # ==================================================================================================
@@ -307,10 +312,48 @@ class WindResistance:
     psi_wt: np.ndarray
 
 
-def _r_aa(v_wr, psi_wr, v_g, cx, a_xv, rho_a, z_a, z_ref):
+def average_true_wind(v_wt, psi_wt, heading):
+    """True wind averaged as a vector over a double run (ITTC 7.5-04-01-01.1 (2017) §"wind": the true
+    wind vectors of the runs of a pair are averaged, then each run's relative wind is recomposed from
+    the mean true wind and that run's heading and speed). v_wt [m/s], psi_wt [rad, from-direction off
+    the bow], heading [rad] per run; returns per run (v_wt, psi_wt) of the mean true wind."""
+    v_wt = np.asarray(v_wt, dtype=float)
+    d = np.asarray(psi_wt, dtype=float) + np.asarray(heading, dtype=float)  # from-direction off north
+    x, y = float(np.mean(v_wt * np.cos(d))), float(np.mean(v_wt * np.sin(d)))
+    mean_dir = math.atan2(y, x)
+    psi = np.arctan2(np.sin(mean_dir - heading), np.cos(mean_dir - heading))
+    return np.full_like(v_wt, math.hypot(x, y)), psi
+
+
+def correct_airwake(speed, angle, speed_coef, direction_coef):
+    """Undo a mast anemometer's airwake calibration: the site reads U_m = U (1 + a₀ + Σ aₖ cos kγ +
+    bₖ sin kγ) at γ_m = γ + c₀ + Σ cₖ sin kγ (γ the undisturbed relative wind angle; coefficients from
+    the ship's airwake survey or model test, ITTC 7.5-04-01-01.1 (2017) §"wind": the anemometer
+    reading is corrected for the ship's own airwake). speed_coef = [a₀, a₁, b₁, a₂, b₂, …],
+    direction_coef = [c₀, c₁, …] [rad]. Returns the undisturbed (speed, angle), γ by fixed point."""
+    sp = np.asarray(speed, dtype=float)
+    gm = np.asarray(angle, dtype=float)
+    ws = np.asarray(speed_coef, dtype=float)
+    wd = np.asarray(direction_coef, dtype=float)
+
+    def off(g):
+        return wd[0] + sum(wd[i] * np.sin(i * g) for i in range(1, wd.size)) if wd.size else 0.0 * g
+
+    g = gm.copy()
+    for _ in range(60):
+        g = gm - off(g)
+    k = (ws.size - 1) // 2
+    fac = 1.0 + (ws[0] if ws.size else 0.0) + sum(ws[2 * i - 1] * np.cos(i * g) + ws[2 * i] * np.sin(i * g)
+                                                  for i in range(1, k + 1))
+    return sp / fac, g
+
+
+def _r_aa(v_wr, psi_wr, v_g, cx, a_xv, rho_a, z_a, z_ref, heading=None):
     v_wt, psi_wt = true_wind(v_wr, psi_wr, v_g)
-    if z_a is not None:
-        v_wt_ref = v_wt * (z_ref / z_a) ** (1.0 / 9.0)
+    if heading is not None:
+        v_wt, psi_wt = average_true_wind(v_wt, psi_wt, heading)
+    if z_a is not None or heading is not None:
+        v_wt_ref = v_wt if z_a is None else v_wt * (z_ref / z_a) ** WIND_PROFILE_EXPONENT
         v_wr_ref, psi_wr_ref = relative_wind(v_wt_ref, psi_wt, v_g)
     else:
         v_wr_ref, psi_wr_ref = np.asarray(v_wr, float), np.asarray(psi_wr, float)
@@ -320,7 +363,7 @@ def _r_aa(v_wr, psi_wr, v_g, cx, a_xv, rho_a, z_a, z_ref):
 
 
 def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anemometer=None,
-                    z_ref=10.0, v_wr_std=None, psi_wr_std=None, cx_rel_std=0.0) -> WindResistance:
+                    z_ref=10.0, v_wr_std=None, psi_wr_std=None, cx_rel_std=0.0, heading=None) -> WindResistance:
     """Resistance increase due to wind (ITTC 7.5-04-01-01.1 (2017) eq. for R_AA; ISO 15016:2015):
 
         R_AA = ½ ρ_A C_X(ψ_WR,ref) A_XV V_WR,ref² − ½ ρ_A C_X(0) A_XV V_G²
@@ -331,8 +374,10 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
     cx(ψ) the ship's wind resistance coefficient (positive = resistance, i.e. −C_X of the usual
     body-axis force convention), a_xv [m²] transverse projected area above the waterline, rho_a
     [kg/m³]. If z_anemometer [m] is given, the true wind is brought to the reference height z_ref of
-    the coefficients by the 1/9 power law V_WT,ref = V_WT (z_ref/z_a)^{1/9} (ITTC 2017) and the relative
-    wind is recomposed; otherwise the measured relative wind is used as is.
+    the coefficients by the 1/9 power law V_WT,ref = V_WT (z_ref/z_a)^{1/9} (ITTC 2017; ISO 15016:2015)
+    and the relative wind is recomposed; otherwise the measured relative wind is used as is. With
+    ``heading`` [rad] per run (the runs of one double run), the true wind vectors are averaged over
+    the runs first (:func:`average_true_wind`, ITTC 2017).
 
     Uncertainty: v_wr_std [m/s], psi_wr_std [rad] propagated by central differences, plus a relative
     uncertainty cx_rel_std of the coefficient (applied to the first term).
@@ -340,7 +385,7 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
     v_wr = np.atleast_1d(np.asarray(v_wr, dtype=float))
     psi_wr = np.atleast_1d(np.asarray(psi_wr, dtype=float))
     v_g = np.atleast_1d(np.asarray(v_g, dtype=float))
-    args = (cx, a_xv, rho_a, z_anemometer, z_ref)
+    args = (cx, a_xv, rho_a, z_anemometer, z_ref, None if heading is None else np.atleast_1d(np.asarray(heading, float)))
     r, vr_ref, pr_ref, vwt, pwt = _r_aa(v_wr, psi_wr, v_g, *args)
     var = np.zeros_like(r)
     if v_wr_std is not None:
@@ -359,30 +404,108 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
 
 
 def direct_power_method(p_ms, delta_r, v_s, eta_d_id, eta_d_ms=None, p_ms_std=None,
-                        delta_r_std=None):
-    """Corrected power by the Direct Power Method (ITTC 7.5-04-01-01.1 (2017); ISO 15016:2015):
+                        delta_r_std=None, xi_p=None):
+    """Corrected power by the Direct Power Method (ITTC 7.5-04-01-01.1 (2017, rev. 2021) §"Direct
+    Power Method"; ISO 15016:2015):
 
         P_D,id = P_D,ms − ΔR V_S/η_D,id − P_D,ms (1 − η_D,ms/η_D,id)
 
     p_ms [W] measured delivered power, delta_r [N] total resistance increase (wind + waves + …),
     v_s [m/s] speed through water, eta_d_id propulsive efficiency in the ideal condition (from the
-    model tests), eta_d_ms in the trial condition. With eta_d_ms None the third term is dropped
-    (η_D,ms = η_D,id: the simple form P_id = P_ms − ΔR V_S/η_D). The standard obtains η_D,ms from
-    the load-variation test (overload factor ξ_P); that relation is not coded here — pass eta_d_ms.
+    model tests), eta_d_ms in the trial condition. The standard takes η_D,ms from the overload factor
+    ξ_P of the load-variation test (:func:`overload_factor`),
 
-    Returns (p_id, std) arrays; std from p_ms_std [W] and delta_r_std [N] (independent).
+        η_D,ms = η_D,id / (1 + ξ_P (P_D,ms − P_D,id)/P_D,id),
+
+    which is implicit in P_D,id and solved here by fixed-point iteration when ``xi_p`` is given. With
+    neither eta_d_ms nor xi_p the third term is dropped (η_D,ms = η_D,id, the simple form
+    P_id = P_ms − ΔR V_S/η_D) — which overstates the corrected power when the propeller is overloaded.
+
+    Returns (p_id, std) arrays; std from p_ms_std [W] and delta_r_std [N] (independent; the small
+    dependence of η_D,ms on the data is not propagated).
     """
     p_ms = np.asarray(p_ms, dtype=float)
     dr = np.asarray(delta_r, dtype=float)
     v_s = np.asarray(v_s, dtype=float)
-    ratio = 1.0 if eta_d_ms is None else np.asarray(eta_d_ms, dtype=float) / eta_d_id
-    p_id = p_ms - dr * v_s / eta_d_id - p_ms * (1.0 - ratio)
+    if xi_p is not None:
+        if eta_d_ms is not None:
+            raise ValueError("give eta_d_ms or xi_p, not both")
+        xi = np.asarray(xi_p, dtype=float)
+        p_id = p_ms - dr * v_s / eta_d_id
+        for _ in range(100):
+            ratio = 1.0 / (1.0 + xi * (p_ms - p_id) / p_id)  # η_D,ms / η_D,id
+            new = p_ms - dr * v_s / eta_d_id - p_ms * (1.0 - ratio)
+            if np.all(np.abs(new - p_id) <= 1e-12 * np.abs(p_ms)):
+                p_id = new
+                break
+            p_id = new
+        ratio = 1.0 / (1.0 + xi * (p_ms - p_id) / p_id)
+    else:
+        ratio = 1.0 if eta_d_ms is None else np.asarray(eta_d_ms, dtype=float) / eta_d_id
+        p_id = p_ms - dr * v_s / eta_d_id - p_ms * (1.0 - ratio)
     var = np.zeros(np.broadcast(p_ms, dr, v_s).shape)
     if p_ms_std is not None:
         var = var + (np.asarray(ratio) * np.asarray(p_ms_std, dtype=float)) ** 2
     if delta_r_std is not None:
         var = var + (v_s / eta_d_id * np.asarray(delta_r_std, dtype=float)) ** 2
     return p_id, np.sqrt(var)
+
+
+def overload_factor(p_d, eta_d, p_d_id, eta_d_id) -> float:
+    """Overload factor ξ_P from a load-variation test at one speed (ITTC 7.5-04-01-01.1 (2017, rev.
+    2021); ISO 15016:2015): the least-squares slope through the origin of η_D,id/η_D − 1 against
+    (P_D − P_D,id)/P_D,id over the test's loadings, the relation the Direct Power Method uses
+    (:func:`direct_power_method`). p_d [W], eta_d [–] per loading; p_d_id, eta_d_id at zero added load."""
+    x = (np.asarray(p_d, dtype=float) - p_d_id) / p_d_id
+    y = eta_d_id / np.asarray(eta_d, dtype=float) - 1.0
+    if x.size < 1 or not np.any(x != 0):
+        raise ValueError("the load-variation test needs at least one loading that changes the power")
+    return float(x @ y / (x @ x))
+
+
+def acceleration_resistance(accel, displacement_m3, rho_water=1025.0, added_mass_fraction=0.08, accel_std=None):
+    """Inertial resistance of a ship still gaining (or losing) speed on a run: R_acc = (m + m_x) a [N],
+    m = ρ ∇, m_x = ``added_mass_fraction`` × m, a [m/s²] the run's mean acceleration along its track.
+    A run the director accepted as steady may still carry a small acceleration that his instruments
+    cannot resolve (a VLCC at 1e-4 m/s² over a 10-min run: 0.1 kn, ~3 % of its resistance); adding
+    R_acc to the resistance increase removes it in the Direct Power Method. This is a correction beyond
+    ITTC 7.5-04-01-01.1 (2017), which asks for steady runs instead. Default m_x/m = 0.08: KVLCC2's
+    m′_x/m′ = 0.022/0.274 (Yasukawa & Yoshimura 2015, J. Mar. Sci. Technol. 20:37–52, Table 3).
+    An acceleration the fixes do not resolve (|a| < 2 std) is taken as zero: only a resolved trend is
+    corrected, as only a significant trend makes the director call a run unsteady.
+    Returns (R_acc, std)."""
+    m = rho_water * float(displacement_m3) * (1.0 + added_mass_fraction)
+    if accel_std is not None:
+        accel = np.where(np.abs(np.asarray(accel, float)) > 2.0 * np.asarray(accel_std, float), accel, 0.0)
+    a = np.asarray(accel, dtype=float)
+    return m * a, (np.zeros_like(a) if accel_std is None else m * np.asarray(accel_std, dtype=float))
+
+
+def along_track_acceleration(t, north, east, t0=None, t1=None):
+    """Mean acceleration along the track [m/s²] in [t0, t1] and its standard error: least-squares
+    quadratic s(t) = s₀ + v t + ½ a t² of the along-track distance (projected on the mean course);
+    the standard error allows for correlated fix errors (sandwich variance of the residuals,
+    :func:`vtrials.reduce.runstats.sandwich_variance`)."""
+
+    t = np.asarray(t, dtype=float)
+    w = np.isfinite(t) & np.isfinite(north) & np.isfinite(east)
+    if t0 is not None:
+        w &= t >= t0
+    if t1 is not None:
+        w &= t <= t1
+    t, n, e = t[w], np.asarray(north, float)[w], np.asarray(east, float)[w]
+    if t.size < 5:
+        raise ValueError("need at least 5 fixes for an acceleration")
+    tc = t - t.mean()
+    vn, ve = np.polyfit(tc, n, 1)[0], np.polyfit(tc, e, 1)[0]
+    c = math.atan2(ve, vn)
+    s = n * math.cos(c) + e * math.sin(c)
+    X = np.column_stack([np.ones_like(tc), tc, 0.5 * tc ** 2])
+    P = np.linalg.pinv(X)
+    beta = P @ s
+    r = s - X @ beta
+    var, _ = sandwich_variance(P[2], r)
+    return float(beta[2]), float(math.sqrt(max(var * t.size / max(t.size - 3, 1), 0.0)))
 
 
 def displacement_correction(power, disp_trial, disp_target, power_std=None):

@@ -107,6 +107,14 @@ def run_statistics(rec: Record, run: dict) -> dict:
     out["tracking"] = primary
     s = out["sog"][primary]["sog"]
     out["vg"] = Estimate(s["value"], s["std"], s["dof"])
+    if out["sog"][primary].get("kind") != "loran":  # the run's residual acceleration along its track
+        t, n = rec.channel(primary, "north")
+        _, e = rec.channel(primary, "east")
+        try:
+            a, a_se = SP.along_track_acceleration(t, n, e, t0, t1)
+            out["accel"] = {"value": a, "std": a_se}
+        except ValueError:
+            pass
     # shafts: power from the torque and r/min meters, net thrust, indicated pitch
     shafts = {}
     for name in kinds.get("shaft_torque", []):
@@ -150,8 +158,12 @@ def run_statistics(rec: Record, run: dict) -> dict:
         ts, sp = rec.channel(a, "speed")
         _, an = rec.channel(a, "angle")
         w = (ts >= t0) & (ts <= t1)
-        vx = float(np.mean(sp[w] * np.cos(an[w])))
-        vy = float(np.mean(sp[w] * np.sin(an[w])))
+        sp, an = sp[w], an[w]
+        m = rec.meta(a)
+        if m.get("airwake_speed") is not None:  # the mast's airwake, known from its survey: removed
+            sp, an = SP.correct_airwake(sp, an, m["airwake_speed"], m.get("airwake_direction_rad", [0.0]))
+        vx = float(np.mean(sp * np.cos(an)))
+        vy = float(np.mean(sp * np.sin(an)))
         out["wind"] = {"instrument": a, "speed": math.hypot(vx, vy), "angle": math.atan2(vy, vx),
                        "speed_se": channels[a]["speed"]["se"] if channels[a]["speed"] else math.nan,
                        "height_m": -float(rec.meta(a)["surveyed_position_m"][2])}
@@ -196,6 +208,13 @@ def _eta_d(tank: dict, v):
     return np.interp(v, tank["speed_mps"], tank["eta_D"])
 
 
+def _xi_p(tank: dict, v):
+    """Overload factor ξ_P of the tank's load-variation test at speed v (None if the tank did none)."""
+    if not tank or not tank.get("xi_P"):
+        return None
+    return float(np.interp(v, tank["speed_mps"], tank["xi_P"]))
+
+
 # ----------------------------------------------------------------------------------- standardization
 def reduce_standardization(rec: Record) -> dict:
     team = rec.team
@@ -206,6 +225,8 @@ def reduce_standardization(rec: Record) -> dict:
     tank = rec.attr("tank_prediction", {})
     windinfo = _wind_cx(team)
     rho_air = 1.225
+    disp = (rec.attr("condition", {}) or {}).get("displacement_m3") or team.get("displacement_m3")
+    rho_w = float(team.get("water_density", 1025.0))
     # all-runs ITTC iterative analysis (tidal current model when the runs allow it): its residual
     # scatter is the run-to-run variability the per-spot eliminations cannot see
     tt = np.array([r["t_mid"] for r in runs])
@@ -246,14 +267,22 @@ def reduce_standardization(rec: Record) -> dict:
             cx, a_xv = windinfo
             wr = SP.wind_resistance([r["wind"]["speed"] for r in rs], [r["wind"]["angle"] for r in rs], v, cx,
                                     a_xv, rho_air, z_anemometer=rs[0]["wind"]["height_m"], z_ref=10.0,
-                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=0.05)
+                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=0.05,
+                                    heading=[r["course"] for r in rs] if n > 1 else None)
             d_r, d_r_se = wr.r_aa, wr.std
             wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
                          for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
+        # the runs' residual acceleration (SP.acceleration_resistance): inertia is not calm-water power
+        r_acc = np.zeros(n)
+        if disp and all("accel" in r for r in rs):
+            r_acc, r_acc_se = SP.acceleration_resistance([r["accel"]["value"] for r in rs], disp, rho_w,
+                                                         accel_std=[r["accel"]["std"] for r in rs])
+            d_r, d_r_se = d_r + r_acc, np.hypot(d_r_se, r_acc_se)
         eta = _eta_d(tank, vs.value)
+        xi = _xi_p(tank, vs.value)
         if eta is not None:
             p_id, p_id_se = SP.direct_power_method(p_ms, d_r, vs.value, float(eta), p_ms_std=p_ms_se,
-                                                   delta_r_std=d_r_se)
+                                                   delta_r_std=d_r_se, xi_p=xi)
         else:
             p_id, p_id_se = p_ms, p_ms_se
         # run-to-run power scatter at equal settings (gusts, helm) as seen after the correction
@@ -277,7 +306,8 @@ def reduce_standardization(rec: Record) -> dict:
                       "stw": _est(vs), "power_measured": _est(P_ms), "power": _est(P),
                       "rps": rps.value, "torque": torque, "thrust": thrust,
                       "current_along_base": current_along, "wind": wind_used,
-                      "eta_D": None if eta is None else float(eta),
+                      "eta_D": None if eta is None else float(eta), "xi_P": xi,
+                      "r_acc": [float(x) for x in np.atleast_1d(r_acc)],
                       "steady": all(r["steady"] for r in rs)})
     _two_run_trend_correction(spots, runs)
     # the faired speed–power curve: monotone cubic through the spots in log–log (trial practice fairs

@@ -394,17 +394,43 @@ def _mv_markdown(tr: dict, figs: list[str]) -> list[str]:
     if imo.get("verdicts"):
         L += [f"IMO MSC.137(76) (L = {imo['length_m']:.1f} m, V = {imo['speed_mps'] / KNOT:.2f} kn):", "",
               "| criterion | value | limit | passed | margin | true value | true verdict |", "|---|---|---|---|---|---|---|"]
-        truth = tr["truth"].get("imo") or {}
-        for k, v in imo["verdicts"].items():
-            if not isinstance(v, dict) or "limit" not in v:
-                continue
-            tv = truth.get(k, {}) if isinstance(truth, dict) else {}
-            val = v["value"]["value"] if isinstance(v["value"], dict) else v["value"]
-            tval = tv.get("value", {}).get("value") if isinstance(tv.get("value"), dict) else tv.get("value")
-            L.append(f"| {v['criterion']} | {_fmt(val, 3)} | {_fmt(v['limit'], 3)} | {v['passed']} | "
-                     f"{_fmt(v.get('margin'), 3)} | {_fmt(tval, 3)} | {tv.get('passed')} |")
+        L += imo_rows(imo["verdicts"], tr["truth"].get("imo") or {})
         L.append("")
     return L
+
+
+def imo_rows(verdicts: dict, truth: dict) -> list[str]:
+    """Markdown rows of the IMO verdict table; angles (kept in rad inside) are printed in degrees,
+    the unit the MSC.137(76) criteria are written in, and every value carries its unit."""
+    rows = []
+    for k, v in verdicts.items():
+        if not isinstance(v, dict) or "limit" not in v:
+            continue
+        tv = truth.get(k, {}) if isinstance(truth, dict) else {}
+        f, unit = (180.0 / math.pi, "°") if v.get("unit") == "rad" else (1.0, f" {v.get('unit')}" if v.get("unit") else "")
+
+        def num(x):
+            x = x.get("value") if isinstance(x, dict) else x
+            return None if x is None else x * f
+
+        def show(x):
+            x = num(x)
+            return "–" if x is None else f"{_fmt(x, 2)}{unit}"
+        rows.append(f"| {v['criterion']} | {show(v['value'])} | {show(v['limit'])} | {v['passed']} | "
+                    f"{show(v.get('margin'))} | {show(tv.get('value'))} | {tv.get('passed')} |")
+    return rows
+
+
+def unsteady_reasons(attempt: dict) -> str:
+    """Why the director found an attempt unsteady (empty when steady): the approach's and the run's
+    reasons from the log sheet, each once, so the reader sees why each repeat happened."""
+    if attempt.get("approach_steady") and attempt.get("run_steady"):
+        return ""
+    parts = []
+    for key, where in (("approach_notes", "approach"), ("run_notes", "run")):
+        for n in dict.fromkeys(attempt.get(key) or []):
+            parts.append(f"{where}: {n}")
+    return "; ".join(parts).replace("|", "/") or "unsteady"
 
 
 # ----------------------------------------------------------------------------------- the document
@@ -413,12 +439,13 @@ def write_report(doc: dict, res, out: Path) -> None:
     L = [f"# {doc['scenario']}", "",
          f"Ship `{doc['ship']}` · seed {doc['seed']} · time step {doc['timestep_s']} s · trial time "
          f"{doc['agenda']['total_time_s'] / 3600:.2f} h · wall time {doc['wall_time_s']:.1f} s", "",
-         "## Agenda", "", "| run | trial | label | course | COMEX | FINEX | run time [min] | steady | accepted |",
-         "|---|---|---|---|---|---|---|---|---|"]
+         "## Agenda", "", "| run | trial | label | course | COMEX | FINEX | run time [min] | steady | accepted | "
+         "why unsteady (the director's judgement) |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
     for a in doc["agenda"]["runs"]:
         L.append(f"| {a['run']}{'' if a['attempt'] == 1 else ' (repeat)'} | {a['trial']} | {a['label']} | "
                  f"{a['course_deg']:.0f}° | {_clock(a['t_comex'])} | {_clock(a['t_finex'])} | {a['elapsed_s'] / 60:.1f} | "
-                 f"{a['approach_steady'] and a['run_steady']} | {a['accepted']} |")
+                 f"{a['approach_steady'] and a['run_steady']} | {a['accepted']} | {unsteady_reasons(a)} |")
     L += ["", "Elapsed trial time per trial: " + ", ".join(f"{k} {v / 3600:.2f} h" for k, v in
                                                             doc["agenda"]["trial_time_s"].items()), ""]
     for tr in doc["trials"]:

@@ -31,6 +31,7 @@ from vtrials.scenario import Scenario, environment_block
 from vtrials.runner.outputs import json_clean
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.records.trial import write_record
+from vtrials.truth.calmwater import load_variation
 from vtrials.truth.columns import describe
 from vtrials.units import DEG, RPM
 
@@ -232,7 +233,8 @@ def tank_prediction(vessel) -> dict:
     """What the towing tank told the trials team: calm-water resistance, delivered power and
     propulsive efficiency η_D = R_T V / P_D at a few speeds (computed from the model's own equations,
     i.e. a perfect tank test of this hull; the reductions use η_D only inside the resistance
-    corrections, as ITTC 7.5-04-01-01.1 does)."""
+    corrections, as ITTC 7.5-04-01-01.1 does), and the overload factor ξ_P of a load-variation test at
+    each speed (:func:`vtrials.truth.calmwater.load_variation`)."""
     key = str(vessel.folder)
     if key in _TANK_CACHE:
         return _TANK_CACHE[key]
@@ -249,6 +251,10 @@ def tank_prediction(vessel) -> dict:
         out["resistance_N"].append(R)
         out["power_W"].append(P)
         out["eta_D"].append(R * V / P)
+    # the load-variation test at the same speeds: the overload factor ξ_P the Direct Power Method needs
+    lv = load_variation(vessel, out["speed_mps"], sim=sim)
+    out["xi_P"] = lv["xi_P"]
+    out["load_variation"] = lv["points"]
     _TANK_CACHE[key] = out
     return out
 

@@ -33,6 +33,7 @@ from vtrials.physics import steering as H
 from vtrials.trials.agenda import Agenda, Run
 from vtrials.physics.dynamics import NV_PSI_U
 from vtrials.errors import SimulationError
+from vtrials.instruments.devices import UNIT_FACTORS
 from vtrials.physics.propulsion import MODE_NAMES, S_CP
 from vtrials.physics.simulator import Simulator
 from vtrials.trials.driver import MAX_SLICE_S, Driver
@@ -52,6 +53,31 @@ def _trend(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     den = float(tc @ tc)
     slope = float(tc @ (y - y.mean())) / den if den > 0 else 0.0
     return float(y.mean()), slope * float(t[-1] - t[0])
+
+
+def trend_noise_sd(t: np.ndarray, white_sd: float = 0.0, resolution: float = 0.0, gm_sd: float = 0.0,
+                   gm_tau_s: float = math.inf) -> float:
+    """Standard deviation of the change across a window that :func:`_trend` reads from an instrument's
+    own errors alone, for a steady quantity: white noise (sd ``white_sd``), quantisation (step
+    ``resolution``, variance step²/12) and a first-order Gauss–Markov error (sd ``gm_sd``, correlation
+    time ``gm_tau_s``: covariance gm_sd² e^{−|Δt|/τ}). The least-squares change is T Σ cᵢ yᵢ with
+    cᵢ = (tᵢ − t̄)/Σ(tⱼ − t̄)², so var = T² cᵀ Σ c (exact for these error models; Bendat & Piersol,
+    *Random Data*, 4th ed., 2010, §4.6 for the Gauss–Markov covariance)."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 3:
+        return math.inf
+    tc = t - t.mean()
+    den = float(tc @ tc)
+    if den <= 0:
+        return math.inf
+    c = tc / den
+    var = (white_sd ** 2 + resolution ** 2 / 12.0) * float(c @ c)
+    if gm_sd > 0:
+        if math.isfinite(gm_tau_s):
+            K = np.exp(-np.abs(t[:, None] - t[None, :]) / gm_tau_s)
+            var += gm_sd ** 2 * float(c @ K @ c)
+    T = float(t[-1] - t[0])
+    return math.sqrt(var) * T
 
 
 def judge(display: dict, course: float | None, st, modes: tuple, torque_floor: float = 0.0) -> tuple[bool, list[str]]:
@@ -85,10 +111,27 @@ def judge(display: dict, course: float | None, st, modes: tuple, torque_floor: f
             why.append(f"heading {math.degrees(err):+.1f}° off the course")
     ld = display["log"]
     if ld is not None:
+        # a log-speed trend is called only when it exceeds the tolerance by more than the log's own
+        # errors could produce over the window (2 × :func:`trend_noise_sd` of its stated noise,
+        # resolution and drift): the director does not chase the log's drift and quantisation
         m, ch = _trend(*ld)
-        if not math.isfinite(ch) or abs(ch) > st.speed_kn * KNOT:
-            why.append(f"log speed changing {ch / KNOT:+.2f} kn over the window")
+        noise = display.get("log_noise") or {}
+        sd = trend_noise_sd(ld[0], **noise) if noise and ld[0].size >= 3 else 0.0
+        if not math.isfinite(ch) or abs(ch) > st.speed_kn * KNOT + 2.0 * sd:
+            why.append(f"log speed changing {ch / KNOT:+.2f} kn over the window (allowed {st.speed_kn:.2f} kn "
+                       f"+ {2.0 * sd / KNOT:.2f} kn for the log's own noise and drift)")
     return not why, why
+
+
+def _stated_noise(spec: dict) -> dict:
+    """The log's stated errors (its catalogue entry, in SI) that the director allows for when judging
+    a trend: white noise, resolution and the Gauss–Markov drift."""
+    f = UNIT_FACTORS.get(spec.get("units", "SI"), 1.0)
+    gm = spec.get("gauss_markov") or {}
+    return {"white_sd": float(spec.get("noise", 0.0) or 0.0) * f,
+            "resolution": float(spec.get("resolution", 0.0) or 0.0) * f,
+            "gm_sd": float(gm.get("sd", 0.0)) * f if isinstance(gm, dict) else 0.0,
+            "gm_tau_s": float(gm.get("tau_s", math.inf)) if isinstance(gm, dict) else math.inf}
 
 
 # ----------------------------------------------------------------------------------- records kept
@@ -234,6 +277,7 @@ class Crew:
         self._runs_done = 0
         logs = self._by_kind["em_log"] or self._by_kind["knotmeter"] or self._by_kind["doppler_log"]
         self._log_inst = logs[0] if logs else None
+        self._log_noise = _stated_noise(self.iset.devices[self._log_inst].spec) if logs else None
         self._gyro = self._by_kind["heading"][0] if self._by_kind["heading"] else None
 
     # ------------------------------------------------------------------ time
@@ -289,6 +333,7 @@ class Crew:
         if self._log_inst is not None:
             kind = self.iset.devices[self._log_inst].kind
             d["log"] = get(self._log_inst, "u" if kind == "doppler_log" else "speed")
+            d["log_noise"] = self._log_noise
         return d
 
     # ------------------------------------------------------------------ orders

@@ -95,3 +95,50 @@ def twin_points(vessel, settings: list[dict], dt: float, window_s: float = 120.0
                               "steady": change < tol_mps, "settle_s": elapsed}
         if done.all():
             return results
+
+
+def load_variation(vessel, speeds, fractions=(-0.1, 0.1, 0.2, 0.3, 0.4), sim: Simulator | None = None) -> dict:
+    """Load-variation test on the model itself: self-propulsion at a fixed speed with an added tow
+    force, the test from which ITTC 7.5-04-01-01.1 (2017, rev. 2021) §"Direct Power Method" and ISO
+    15016:2015 take the overload factor ξ_P (see :func:`vtrials.reduce.speedpower.overload_factor`).
+
+    At each speed V [m/s] (an ascending list) the ship is first self-propelled (R_T from the hull
+    components, delivered power P_D,id); then for each ΔR = f R_T, f in ``fractions``, the shaft speed is
+    found at which the net surge force equals ΔR (the ship pushes the extra resistance, as in a head wind
+    on trial), at the same trim, and P_D and η_D = (R_T + ΔR) V / P_D recorded. ξ_P is the least-squares
+    slope through the origin of η_D,id/η_D − 1 against (P_D − P_D,id)/P_D,id. Returns
+    {"speed_mps", "xi_P", "points": per speed [{dR_N, rps, power_W, eta_D}]}.
+    """
+    from scipy.optimize import brentq
+
+    sim = sim or Simulator(vessel, 1, 0.05, record_every=0)
+    hull = [i for i, n in enumerate(sim.comp_names) if n.startswith("hull")]
+    # a model propeller in the tank is not held to the engine's limit: search up to 3 × the rated speed
+    n_hi = 3.0 * float(np.max([sh.max_rps for sh in vessel.shafts]))
+    out = {"speed_mps": [], "xi_P": [], "points": []}
+    for V in speeds:
+        s = sim.self_propulsion(0, float(V))
+        P0 = float(sum(sim.shaft_power(0)))
+        R0 = -float(sum(sim.comp_w[0, i, 0] for i in hull))
+        eta0 = R0 * V / P0
+        pts, x, y = [{"dR_N": 0.0, "rps": float(s.shaft_rps[0]), "power_W": P0, "eta_D": eta0}], [], []
+        for f in fractions:
+            dR = f * R0
+
+            def resid(n):
+                s.shaft_rps = (n,) * sim.ns
+                return sim._surge_residual(0, s) - dR  # noqa: SLF001 (the simulator's own surge balance)
+
+            n = brentq(resid, 1e-6, n_hi, xtol=1e-13, rtol=1e-14)
+            s.shaft_rps = (n,) * sim.ns
+            sim.set_state(0, s)
+            P = float(sum(sim.shaft_power(0)))
+            eta = (R0 + dR) * V / P
+            pts.append({"dR_N": dR, "rps": n, "power_W": P, "eta_D": eta})
+            x.append((P - P0) / P0)
+            y.append(eta0 / eta - 1.0)
+        x, y = np.asarray(x), np.asarray(y)
+        out["speed_mps"].append(float(V))
+        out["xi_P"].append(float(x @ y / (x @ x)))  # as vtrials.reduce.speedpower.overload_factor
+        out["points"].append(pts)
+    return out

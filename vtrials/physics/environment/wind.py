@@ -3,8 +3,9 @@
 Everything is SI inside: speeds in m/s, heights in m, frequencies f in Hz (ω = 2πf in rad/s),
 angles in rad. Knots and degrees appear only in names that say so (the scenario edge, :class:`Wind`).
 
-1. Mean wind profile (power law to the 10 m reference), ISO 15016:2015 (exponent 1/7; ITTC
-   7.5-04-01-01.1 uses 1/9, see docs/environment.md):
+1. Mean wind profile (power law to the 10 m reference), exponent 1/9 as in ITTC 7.5-04-01-01.1
+   (2017, rev. 2021) §"Resistance increase due to wind" and ISO 15016:2015, which the trial analysis
+   (vtrials.reduce.speedpower) uses to bring the anemometer's wind to the reference height:
        U(z) = U₁₀ (z / 10 m)^α.
 
 2. Gust spectra, one-sided S(f) in (m/s)²/Hz of the longitudinal gust u'(t) (zero mean):
@@ -122,7 +123,8 @@ from vtrials.units import DEG, KNOT
 
 
 RHO_AIR = 1.225  # [kg/m³] ISO 2533:1975 standard atmosphere, sea level, 15 °C
-ISO15016_EXPONENT = 1.0 / 7.0  # power-law exponent of the mean wind profile, ISO 15016:2015
+TRIALS_PROFILE_EXPONENT = 1.0 / 9.0  # mean wind profile exponent, ITTC 7.5-04-01-01.1 (2017) and ISO 15016:2015
+ISO15016_EXPONENT = TRIALS_PROFILE_EXPONENT  # former name
 Z_REF_10 = 10.0  # [m] reference height of U₁₀
 
 NPD_N = 0.468  # ISO 19901-1:2015 / DNV-RP-C205 NPD spectrum exponent
@@ -164,8 +166,8 @@ def env_width(n_gusts: int) -> int:
 # 1. Mean wind profile
 # =================================================================================================
 
-def mean_wind_at_height(U10, z, exponent: float = ISO15016_EXPONENT):
-    """Mean wind speed at height z [m] from U₁₀ [m/s]: U₁₀ (z/10)^exponent (ISO 15016:2015: 1/7)."""
+def mean_wind_at_height(U10, z, exponent: float = TRIALS_PROFILE_EXPONENT):
+    """Mean wind speed at height z [m] from U₁₀ [m/s]: U₁₀ (z/10)^exponent (ITTC 2017 / ISO 15016:2015: 1/9)."""
     z = np.asarray(z, dtype=float)
     if np.any(z <= 0.0):
         raise ValueError("height z must be > 0 m")
@@ -489,7 +491,7 @@ def pack_wind(params: Windage, rho_air: float = RHO_AIR) -> np.ndarray:
 
 
 def pack_wind_env(base_env: np.ndarray, U10: float, direction_from: float,
-                  exponent: float = ISO15016_EXPONENT, z_ref: float = Z_REF_10,
+                  exponent: float = TRIALS_PROFILE_EXPONENT, z_ref: float = Z_REF_10,
                   gusts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """A copy of ``base_env`` (e.g. :func:`vtrials.physics.environment.current.pack`) with the wind written in (SI).
 
@@ -526,8 +528,8 @@ class Wind:
     speed_kn: float = num("mean wind speed at 10 m (1-hour mean for NPD)", "kn", 0.0, 150.0, default=0.0)
     direction_deg: float = num("direction the wind blows FROM (from north, clockwise)", "deg",
                                -360.0, 360.0, default=0.0)
-    profile_exponent: float = num("power-law exponent of the mean profile (ISO 15016: 1/7, ITTC: 1/9)",
-                                  "", 0.0, 1.0, default=ISO15016_EXPONENT)
+    profile_exponent: float = num("power-law exponent of the mean profile (ITTC 2017 and ISO 15016:2015: 1/9)",
+                                  "", 0.0, 1.0, default=TRIALS_PROFILE_EXPONENT)
     reference_height_m: float = num("height the ship's wind loads refer to", "m", 0.0, 200.0,
                                     lo_open=True, default=Z_REF_10)
     gust_spectrum: str = text("gust spectrum", ("none", "npd", "harris", "davenport"), default="none")
