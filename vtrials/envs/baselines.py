@@ -9,7 +9,8 @@ integration held while saturated). Per task:
 * ZigZag: the helmsman's rule on the gyro: δ_z to the side of the current phase, reversed when the
   heading change passes ±ψ_z.
 * Williamson: hard over to starboard until the heading has changed 60°, hard to port until within 20°
-  of the reciprocal course, then the autopilot on the reciprocal (IMO MSC/Circ.1053).
+  of the reciprocal course (IMO MSC/Circ.1053), then the autopilot with line-of-sight guidance (below)
+  onto the original track line run in reverse.
 * Stopping: the autopilot on the track course; full astern (back_full) once the GNSS distance to the mark
   is within the crash-stop reach at the measured speed (reach ∝ U², calibrated at full ahead:
   STOP_REACH_L), stop once the ship is at rest.
@@ -76,7 +77,10 @@ class PIDPolicy:
             recip = t.psi0 + math.pi
             self.phase = np.where((self.phase == 0) & (dpsi >= 60 * DEG), 1, self.phase)
             self.phase = np.where((self.phase == 1) & (np.abs(wrap(m[:, 0] - recip)) <= 20 * DEG), 2, self.phase)
-            delta = np.where(self.phase == 0, self.limit, np.where(self.phase == 1, -self.limit, self._pid(recip)))
+            # back on the track: line-of-sight onto the original line run in reverse (cross-track sign flips)
+            ect, _ = t.track_errors(m[:, 2], m[:, 3], m[:, 0], np.arange(c.n))
+            psi_d = recip - np.arctan(-ect / (2.0 * c.L))
+            delta = np.where(self.phase == 0, self.limit, np.where(self.phase == 1, -self.limit, self._pid(psi_d)))
         elif name == "Stopping":
             delta = self._pid(t.psi0)
             ect, along = t.track_errors(m[:, 2], m[:, 3], m[:, 0], np.arange(c.n))

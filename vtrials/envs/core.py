@@ -112,7 +112,7 @@ class ShipBatch:
         env0 = np.zeros(self.env_width)
         env0[:base.shape[0]] = base
         self.sim = Simulator(v, self.n, self.dt, envs=env0, nthread=nthread, record_every=0)
-        parts, sites, self.devices = suite_parts(v)
+        parts, sites, self.devices, self.dev_index = suite_parts(v)
         self.obs_model = ObservationModel(parts, sites, self.n, self.period, self.max_steps)
         self.rng = [np.random.default_rng() for _ in range(self.n)]
         self.steps = np.zeros(self.n, dtype=np.int64)
@@ -209,7 +209,8 @@ class ShipBatch:
         self.truth = {"t": sim.time.copy(), "x": c[:, L.POS].copy(), "y": c[:, L.POS + 1].copy(),
                       "psi": c[:, L.EUL + 2].copy(), "u_r": c[:, L.NU_R].copy(), "v_r": c[:, L.NU_R + 1].copy(),
                       "r": c[:, L.NU + 5].copy(), "vn": vn, "ve": ve, "sog": np.hypot(vn, ve),
-                      "rudder": c[:, L.DELTA].copy(), "shaft_rps": c[:, L.SHAFT_N].copy()}
+                      "rudder": c[:, L.DELTA + self.dev_index["rudder"]].copy(),
+                      "shaft_rps": c[:, L.SHAFT_N + self.dev_index["shaft_rps"]].copy()}
         return self.truth
 
     def _observe(self, idx: np.ndarray, first: bool = False) -> None:

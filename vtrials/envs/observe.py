@@ -76,9 +76,10 @@ def default_site() -> dict:
             "water_depth_m": 1.0e4}
 
 
-def suite_parts(vessel) -> tuple[dict[str, ErrorParts], dict[str, np.ndarray], dict[str, str]]:
-    """The error parts of each channel, the sensor sites (hull frame, m) and the device names, read
-    from the ship's instrument suite (first device of each kind in name order)."""
+def suite_parts(vessel) -> tuple[dict[str, ErrorParts], dict[str, np.ndarray], dict[str, str], dict[str, int]]:
+    """The error parts of each channel, the sensor sites (hull frame, m), the device names and the
+    rudder / propeller index the rudder synchro and the shaft counter read, from the ship's
+    instrument suite (first device of each kind in name order)."""
     from vtrials.instruments.suite import InstrumentSet
     iset = InstrumentSet(vessel, 0, default_site())
     dev = {}
@@ -107,7 +108,9 @@ def suite_parts(vessel) -> tuple[dict[str, ErrorParts], dict[str, np.ndarray], d
                 parts[ch] = base
         else:
             parts[ch] = _parts(s, d.f)
-    return parts, sites, dev
+    index = {"rudder": int(iset.devices[dev["rudder"]].index),
+             "shaft_rps": int(iset.devices[dev["shaft_rps"]].index)}
+    return parts, sites, dev, index
 
 
 class ObservationModel:
