@@ -178,8 +178,9 @@ def test_observation_model_matches_instrument_set_statistics():
           "shaft_rps": truth["shaft_rps"]}
     # the truth at a device's own sample time (the ship moves ~7.5 m between 1 Hz fixes)
     series = {"north": part["x"] + c * gx - s * gy, "east": part["y"] + s * gx + c * gy}
+    iset = InstrumentSet(v, 0, default_site())
     for i in range(M):
-        iset = InstrumentSet(v, 5000 + i, default_site())
+        iset.seed = 5000 + i  # a new draw of every instrument (their streams are keyed on the seed)
         iset.reset()
         out = {}
         for ch, (src, chan) in want.items():
