@@ -27,6 +27,9 @@ class ShipVectorEnv(VectorEnv):
                  discrete: bool = False, engine_action: bool | None = None, stack: int = 1,
                  control_period_s: float | None = None, task_options: dict | None = None, nthread: int = 1,
                  render_mode: str | None = None, width: int = 480, height: int = 320):
+        from vtrials.physics.simulator import PARALLEL_FROM
+        # threads only pay off for batches the kernel spreads over threads (MuJoCo's too)
+        nthread = int(nthread) if num_envs >= PARALLEL_FROM else 1
         self.core = ShipBatch(task, ship, num_envs, sea, discrete, engine_action, stack, control_period_s,
                               task_options, nthread)
         self.num_envs = int(num_envs)
