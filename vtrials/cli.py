@@ -62,6 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Commands:\n  run      simulate a scenario file and write truth, records, results and plots\n"
                "  inspect  list a trial record's channels, rates and units; plot chosen channels\n"
                "  campaign run many randomized replicates of an agenda; coverage and sharpness of every interval\n"
+               "  render   render a run's truth as a video (MuJoCo, offscreen)\n"
                "  models   list the vessel models\n\nSee 'vtrials run --help' for the scenario format.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"vtrials {__version__}")
@@ -107,6 +108,15 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--resume", action="store_true", help="continue a campaign killed before it finished")
     c.add_argument("--records", action="store_true", help="keep every replicate's records and truth")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
+    ren = sub.add_parser("render", help="render a run's truth as a video",
+                         description="Render the ship of RUN_DIR/truth.nc in its sea with its wake (MuJoCo, "
+                                     "offscreen: MUJOCO_GL=egl or osmesa where there is no display).")
+    ren.add_argument("run_dir", metavar="RUN_DIR", help="a directory written by 'vtrials run'")
+    ren.add_argument("--out", metavar="VIDEO", required=True, help="video file (.mp4 needs imageio-ffmpeg; .gif)")
+    ren.add_argument("--run", metavar="NAME", help="which maneuver of the run (default: the first)")
+    ren.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
+    ren.add_argument("--speed", type=float, default=None,
+                     help="simulated seconds per video second (default: the run in at most 60 s)")
     return p
 
 
@@ -257,6 +267,14 @@ def main(argv: list[str] | None = None) -> int:
             return _inspect(args)
         if args.command == "campaign":
             return _campaign(args)
+        if args.command == "render":
+            from vtrials.envs.video import render_run
+            if args.fps < 1:
+                raise InputError("--fps", "", f"{args.fps}: at least 1 frame per second")
+            doc = render_run(args.run_dir, args.out, fps=args.fps, speed=args.speed, run=args.run)
+            print(f"wrote {doc['file']}: {doc['frames']} frames of run {doc['run']} "
+                  f"({doc['simulated_s']:.0f} s simulated, {doc['speed']:.1f}x)")
+            return 0
     except SimulationError as exc:
         text = str(exc)
         print(f"vtrials: {text if text.startswith('simulation stopped') else 'simulation stopped: ' + text}",
