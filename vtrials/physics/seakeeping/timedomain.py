@@ -16,6 +16,9 @@ How the two models combine (nothing counted twice):
   - roll keeps the ship file's roll damping (linear fraction of critical + quadratic) as the
     viscous part (a documented equivalent linearisation standing in for Ikeda's method, which is not
     implemented here); the wave-radiation part of roll damping comes from the memory.
+* Mean drift (surge, sway, yaw): the database's zero-speed drift per component
+  (:mod:`vtrials.physics.forces.wave_drift`); the maneuvering model's calm-water resistance is unchanged,
+  so the added resistance is this force alone.
 * Restoring stays the ship file's hydrostatics component (not the database mesh's C).
 """
 
@@ -27,7 +30,7 @@ import numpy as np
 
 from vtrials.physics.forces import hydrostatics
 from vtrials.physics.forces import radiation as rad_force
-from vtrials.physics.forces import wave_excitation
+from vtrials.physics.forces import wave_drift, wave_excitation
 from vtrials.physics.forces.registry import Component
 from vtrials.physics.seakeeping.radiation import fit_radiation
 
@@ -35,13 +38,14 @@ SEAKEEPING_DOFS = (2, 3, 4)
 
 
 def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
-                      excitation_dofs=(0, 1, 2, 3, 4, 5)):
+                      excitation_dofs=(0, 1, 2, 3, 4, 5), drift: bool = True):
     """A shallow copy of ``vessel`` with A∞ in its added mass (heave/roll/pitch block), the damping
     component reduced to its roll (viscous) part, and the radiation and wave-excitation components.
 
     ``components``: wave components (n, 6) of :mod:`vtrials.physics.environment.waves`; ``dt``: the
     simulator step [s] (the radiation states are discretised for it); ``model``: a fitted
-    :class:`.radiation.RadiationModel` (fitted here when None). Returns (vessel, model).
+    :class:`.radiation.RadiationModel` (fitted here when None); ``drift``: add the mean drift
+    component (:mod:`vtrials.physics.forces.wave_drift`). Returns (vessel, model).
     """
     if model is None:
         model = fit_radiation(db, dofs=SEAKEEPING_DOFS)
@@ -63,6 +67,8 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
     comps.append(Component("radiation", "radiation", p, states=s0))
     comps.append(Component("wave_excitation", "wave_excitation",
                            wave_excitation.pack(db, components, excitation_dofs)))
+    if drift:
+        comps.append(Component("wave_drift", "wave_drift", wave_drift.pack(db, components)))
     v.components = comps
     return v, model
 
