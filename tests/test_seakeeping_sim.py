@@ -84,3 +84,14 @@ def test_head_seas_heave_pitch_match_rao(patrol, omega, speed):
         td = (c[0] + 1j * c[1]) / ce
         err = abs(td - fd[d]) / abs(fd[d])
         assert err <= 0.05, (omega, speed, col, td, fd[d], err)
+
+
+def test_radiation_states_refuse_another_step(patrol):
+    """The memory is discretised for one step: a simulator with another step stops on a non-finite force."""
+    ves, db, model = patrol
+    comp = np.array([[AMP, 0.7, 0.7 ** 2 / db.g, -1.0, 0.0, 0.0]])
+    v2, _ = seakeeping_vessel(ves, db, comp, DT, model=model)
+    sim = Simulator(v2, 1, 2 * DT)
+    sim.set_state(0, ShipState(shaft_rps=(0.0,) * len(ves.shafts)))
+    sim.evaluate()
+    assert np.all(np.isnan(sim.comp_w[0, sim.comp_names.index("radiation")]))

@@ -10,7 +10,8 @@ zero mean about the maneuvering motion, so the memory adds no steady force to th
 speed coupling the zero-speed RAO does not have. The A∞ part of
 the radiation force is in the added-mass matrix of the dynamics' exact solve, not here.
 
-Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n)]; states: x.
+Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n), h]; states: x.
+A simulator whose step is not h gets a non-finite force (and stops with a status) rather than a wrong memory.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ def pack(model, dt: float) -> tuple[np.ndarray, np.ndarray]:
     dofs = np.array(model.dofs)
     n = model.n_states
     p = np.concatenate([[n, dofs.size], dofs.astype(float), Phi.ravel(), Gam[:, dofs].ravel(),
-                        model.C[dofs].ravel()])
+                        model.C[dofs].ravel(), [dt]])
     return p.astype(np.float64), np.zeros(n)
 
 
@@ -41,6 +42,11 @@ def radiation_kernel(p, s, env, ctx, aux, w):
     o_phi = 2 + m
     o_gam = o_phi + n * n
     o_c = o_gam + n * m
+    if abs(ctx[L.DT] - p[o_c + m * n]) > 1e-9 * p[o_c + m * n]:
+        # discretised for another step: fail loudly (the simulator stops on a non-finite force)
+        for j in range(6):
+            w[j] = math.nan
+        return
     for j in range(6):
         w[j] = 0.0
     for r in range(m):
