@@ -40,12 +40,17 @@ def encounter_frequency(omega, beta, U: float, g: float = 9.80665) -> np.ndarray
     return omega - omega ** 2 * U * np.cos(beta) / g
 
 
-def rao(db, omega, beta: float, U: float = 0.0, dofs=(2, 3, 4), M=None, C=None, B_visc=None) -> np.ndarray:
+def rao(db, omega, beta: float, U: float = 0.0, dofs=(2, 3, 4), M=None, C=None, B_visc=None,
+        body_axes_added_mass: bool = False) -> np.ndarray:
     """Complex RAO ξ̂ (nω, 6) per metre of wave amplitude [m/m, rad/m] (zeros in the held DOFs).
 
     db: :class:`.database.HydroDatabase`; omega (nω,) wave frequencies [rad/s]; beta [rad]; U [m/s];
     M (6, 6) rigid-body mass matrix about O (default: the database's), C (6, 6) restoring (default:
     the database's), B_visc (6, 6) linear viscous damping [N s/m, N m s/rad] (default none).
+    ``body_axes_added_mass``: add the speed term of the time-domain model, whose infinite-frequency
+    added mass multiplies body-axis accelerations: the body heave velocity is w = ż + Uθ, so
+    A∞_i3 ẇ = A∞_i3 (z̈ + U θ̇), i.e. Z_i5 += iω_e U A∞_i3 (the A∞ part of Salvesen, Tuck & Faltinsen's
+    1970 speed coupling B35 = B35⁰ + U A33). Off (default): the plain zero-speed RAO.
     Raises InputError when an encounter frequency is zero (no linear steady state).
     """
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
@@ -73,6 +78,8 @@ def rao(db, omega, beta: float, U: float = 0.0, dofs=(2, 3, 4), M=None, C=None, 
     sub = np.ix_(idx, idx)
     for n in range(omega.size):
         Z = -we[n] ** 2 * (M + A[n]) + 1j * we[n] * (B[n] + Bv) + C
+        if body_axes_added_mass:
+            Z[:, 4] += 1j * we[n] * U * db.A_inf[:, 2]
         out[n, idx] = np.linalg.solve(Z[sub], Xw[n, idx])
     return out
 
