@@ -19,6 +19,12 @@ How the two models combine (nothing counted twice):
 * Mean drift (surge, sway, yaw): the database's zero-speed drift per component
   (:mod:`vtrials.physics.forces.wave_drift`); the maneuvering model's calm-water resistance is unchanged,
   so the added resistance is this force alone.
+* Forward speed: no speed corrections are added. The dynamics apply A∞ to body-axis accelerations,
+  and the body heave velocity is w = ż + Uθ, so the time domain carries a speed coupling
+  A∞_i3 U θ̇ (the A∞ part of Salvesen–Tuck–Faltinsen's B35 = B35⁰ + U A33); the matching RAO is
+  :func:`.rao.rao` with ``body_axes_added_mass=True``.
+* Roll damping: patrol51's ship file has zero roll damping (only the potential damping of the memory
+  then acts); kvlcc2's is 6.1e9 N m s/rad. Ikeda's method and bilge keels are not implemented.
 * Restoring stays the ship file's hydrostatics component (not the database mesh's C).
 """
 
