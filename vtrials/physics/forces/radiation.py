@@ -10,7 +10,8 @@ zero mean about the maneuvering motion, so the memory adds no steady force to th
 speed coupling the zero-speed RAO does not have. The A∞ part of
 the radiation force is in the added-mass matrix of the dynamics' exact solve, not here.
 
-Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n), h]; states: x.
+Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n), h]; states: x (n),
+then scratch: n for the new x and n_dofs for the inputs (held as component states: no allocation per step).
 A simulator whose step is not h gets a non-finite force (and stops with a status) rather than a wrong memory.
 """
 
@@ -32,7 +33,7 @@ def pack(model, dt: float) -> tuple[np.ndarray, np.ndarray]:
     n = model.n_states
     p = np.concatenate([[n, dofs.size], dofs.astype(float), Phi.ravel(), Gam[:, dofs].ravel(),
                         model.C[dofs].ravel(), [dt]])
-    return p.astype(np.float64), np.zeros(n)
+    return p.astype(np.float64), np.zeros(2 * n + dofs.size)   # x, then scratch (no allocation per step)
 
 
 @nb.njit(cache=True, fastmath=False)
@@ -66,15 +67,15 @@ def radiation_kernel(p, s, env, ctx, aux, w):
             w[o + k] = ctx[L.ROT + k] * fn + ctx[L.ROT + 3 + k] * fe + ctx[L.ROT + 6 + k] * fd
     # inputs: seakeeping-frame perturbation velocities: heave = vertical (down) velocity of the origin,
     # roll and pitch rates (body rates, equal to first order); surge/sway/yaw if listed: body values
-    u = np.empty(m)
+    u = s[2 * n:2 * n + m]
     for r in range(m):
         d = int(p[2 + r])
         if d == 2:
             u[r] = ctx[L.ROT + 6] * ctx[L.NU] + ctx[L.ROT + 7] * ctx[L.NU + 1] + ctx[L.ROT + 8] * ctx[L.NU + 2]
         else:
             u[r] = ctx[L.NU_R + d]
-    # advance: x⁺ = Φ x + Γ u (u held over the step); a small stack buffer through the output trick
-    tmp = np.empty(n)
+    # advance: x⁺ = Φ x + Γ u (u held over the step), through the scratch part of the states
+    tmp = s[n:2 * n]
     for k in range(n):
         acc = 0.0
         for l in range(n):

@@ -51,14 +51,17 @@ def drift_kernel(p, s, env, ctx, aux, w):
     base = 2 + nbeta
     stride = 3 + 3 * nbeta
     psi = ctx[L.EUL + 2]
+    cp = math.cos(psi)
+    sp = math.sin(psi)
     fx = 0.0
     fy = 0.0
     mz = 0.0
     for c in range(n):
         q = base + c * stride
         a2 = p[q]
-        mu = math.atan2(p[q + 2], p[q + 1])
-        b = math.atan2(math.sin(mu - psi), math.cos(mu - psi))
+        cm = p[q + 1]
+        sm = p[q + 2]
+        b = math.atan2(sm * cp - cm * sp, cm * cp + sm * sp)     # β = μ − ψ in (−π, π]
         sgn = 1.0
         if b < 0.0:
             b = -b
@@ -73,8 +76,6 @@ def drift_kernel(p, s, env, ctx, aux, w):
         fx += a2 * ((1.0 - fr) * p[t0] + fr * p[t1])
         fy += sgn * a2 * ((1.0 - fr) * p[t0 + 1] + fr * p[t1 + 1])
         mz += sgn * a2 * ((1.0 - fr) * p[t0 + 2] + fr * p[t1 + 2])
-    cp = math.cos(psi)
-    sp = math.sin(psi)
     fn = cp * fx - sp * fy
     fe = sp * fx + cp * fy
     for k in range(3):

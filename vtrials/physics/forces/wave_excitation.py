@@ -69,6 +69,8 @@ def excitation_kernel(p, s, env, ctx, aux, w):
     y = ctx[L.POS + 1]
     t = ctx[L.TIME]
     psi = ctx[L.EUL + 2]
+    cp = math.cos(psi)
+    sp = math.sin(psi)
     for j in range(6):
         w[j] = 0.0
     for c in range(n):
@@ -81,8 +83,8 @@ def excitation_kernel(p, s, env, ctx, aux, w):
         th = om * t - k * (x * cm + y * sm) + p[q + 5]
         ct = a * math.cos(th)
         st = a * math.sin(th)
-        mu = math.atan2(sm, cm)
-        b = math.atan2(math.sin(mu - psi), math.cos(mu - psi))   # wrapped to (−π, π]
+        # β = μ − ψ in (−π, π] from cos/sin of the difference (one atan2, no further trig)
+        b = math.atan2(sm * cp - cm * sp, cm * cp + sm * sp)
         sgn = 1.0
         if b < 0.0:
             b = -b
@@ -105,8 +107,6 @@ def excitation_kernel(p, s, env, ctx, aux, w):
         w[d] *= p[2 + d]
     # the sums are in the seakeeping frame (x along the heading, horizontal; z down): to body axes,
     # f_body = Rᵀ Rz(ψ) f, so that a heeled or trimmed ship is not pushed sideways by a vertical load
-    cp = math.cos(psi)
-    sp = math.sin(psi)
     for o in (0, 3):
         fn = cp * w[o] - sp * w[o + 1]
         fe = sp * w[o] + cp * w[o + 1]
