@@ -5,7 +5,9 @@ every field):
 
 ``[scenario]``      title, ship (a folder under models/), seed, timestep_s, planar, record_every
 ``[initial]``       exactly one of froude_number / speed_kn / speed_mps; heading_deg; propulsion
-``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.physics.environment.current.Current`)
+``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.physics.environment.current.Current`);
+                    ``[environment.waves]`` (:class:`vtrials.physics.environment.waves.Waves`; a seaway realized
+                    from the scenario seed, see :func:`wave_field` and :func:`sea_vessel`)
 ``[[maneuver]]``    one table per maneuver, with ``kind`` and that kind's fields
                     (:mod:`vtrials.trials.programs`), run side by side, one ship each
 ``[agenda]``        instead of maneuvers: a trial agenda executed run by run on one ship by the virtual
@@ -31,6 +33,7 @@ from vtrials.physics.environment.wind import Wind
 from vtrials.schema import (_short, check_name, did_you_mean, choice, flag, integer, load_toml, num, read_table, table, table_list, text,
                             unknown_key)
 from vtrials.physics.environment.current import Current
+from vtrials.physics.environment.waves import Waves
 from vtrials.units import DEG, KNOT, froude_to_speed
 from vtrials.physics.vessel import Vessel, load_vessel
 
@@ -123,6 +126,7 @@ class Scenario:
     site: dict = dataclasses.field(default_factory=dict)
     instrument_items: list = dataclasses.field(default_factory=list)
     agenda: object = None  # vtrials.trials.agenda.Agenda when the scenario is an agenda
+    waves: Waves = dataclasses.field(default_factory=Waves)  # calm unless [environment.waves] says so
 
     @property
     def speed(self) -> float:
@@ -171,9 +175,18 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     if len(given) > 1 or (len(given) == 0 and not has_agenda):
         raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps, engine_order"
                          + (f" (got {', '.join(given)})" if given else ""))
+<<<<<<< HEAD
     env_tab = table(doc.get("environment"), f, "environment")
     cur_tab = table(env_tab.pop("current", None), f, "environment.current")
     wind_tab = table(env_tab.pop("wind", None), f, "environment.wind")
+=======
+    env_tab = dict(doc.get("environment", {}))
+    if not isinstance(env_tab, dict):
+        raise InputError(f, "environment", "expected a table")
+    cur_tab = env_tab.pop("current", {})
+    wind_tab = env_tab.pop("wind", {})
+    waves_tab = env_tab.pop("waves", {})
+>>>>>>> seakeeping
     env, _ = read_table(Environment, env_tab, f, "environment")
     if env.water_depth_m <= vessel.particulars.draught:
         raise InputError(f, "environment.water_depth_m", f"{env.water_depth_m} m does not float the ship "
@@ -187,8 +200,20 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     wind, _ = read_table(Wind, wind_tab, f, "environment.wind")
     if wind.speed_kn > 0 and vessel.windage is None:
         raise InputError(f, "environment.wind.speed_kn", f"{vessel.name} has no [windage] data for wind loads")
+<<<<<<< HEAD
     items = table_list(doc.get("maneuver", []), f, "maneuver")
     if not has_agenda and not items:
+=======
+    if not isinstance(waves_tab, dict):
+        raise InputError(f, "environment.waves", "expected a table")
+    waves, _ = read_table(Waves, waves_tab, f, "environment.waves")
+    waves.check(f)
+    if (waves.hs_m > 0.0 or waves.swell_hs_m > 0.0) and not _hydro_path(vessel).is_file():
+        raise InputError(f, "environment.waves", f"{vessel.name} has no hydrodynamic database "
+                         f"({_hydro_path(vessel)}) for wave loads")
+    items = doc.get("maneuver", [])
+    if not has_agenda and (not isinstance(items, list) or not items):
+>>>>>>> seakeeping
         raise InputError(f, "maneuver", "expected at least one [[maneuver]] table (or an [agenda])")
     maneuvers = []
     names = set()
@@ -241,9 +266,15 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     agenda = None
     if has_agenda:
         from vtrials.trials.agenda import load_agenda
+<<<<<<< HEAD
         agenda = load_agenda(table(doc["agenda"], f, "agenda"), vessel, f)
     instruments = table_list(doc.get("instrument", []), f, "instrument")
     scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda)
+=======
+        agenda = load_agenda(doc["agenda"], vessel, f)
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []), agenda,
+                   waves=waves)
+>>>>>>> seakeeping
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
     from vtrials.instruments.suite import InstrumentSet
     InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
@@ -264,3 +295,43 @@ def environment_block(scn: Scenario) -> np.ndarray:
     env = pack_current(scn.current, scn.environment.water_depth_m)
     gust_seed, = np.random.SeedSequence(scn.head.seed).spawn(1)
     return pack_wind(scn.wind, env, np.random.default_rng(gust_seed))
+
+
+def _hydro_path(vessel: Vessel) -> Path:
+    """The ship's BEM database: ``models/<ship>/hydro/<ship>_hydro.nc`` (written by
+    :mod:`vtrials.physics.seakeeping.build`)."""
+    return Path(vessel.folder) / "hydro" / f"{vessel.name}_hydro.nc"
+
+
+def wave_field(scn: Scenario):
+    """The scenario's seaway realization (:class:`vtrials.physics.environment.waves.WaveField`), or
+    None in a calm sea. Drawn from the second child of the scenario seed's SeedSequence (the first
+    draws the wind gusts, :func:`environment_block`): same seed → same sea, independent of the gusts."""
+    w = scn.waves
+    if not (w.hs_m > 0.0 or w.swell_hs_m > 0.0):
+        return None
+    from vtrials.physics.environment.waves import realize
+    _, wave_seed = np.random.SeedSequence(scn.head.seed).spawn(2)
+    return realize(w, scn.environment.water_depth_m, np.random.default_rng(wave_seed))
+
+
+def sea_vessel(scn: Scenario, dt: float | None = None, model=None):
+    """The scenario's ship with the seakeeping force components for its seaway (the calm-water
+    ``scn.vessel`` itself in a calm sea), for a simulator with step ``dt`` (default: the scenario's).
+
+    Components outside the database's frequency range [ω_min/2, ω_max] are left out (their share of
+    the sea's variance is returned with the vessel as ``(vessel, dropped_variance_fraction)``).
+    Calm-water references (truth) must keep using ``scn.vessel``.
+    """
+    field = wave_field(scn)
+    if field is None:
+        return scn.vessel, 0.0
+    from vtrials.physics.seakeeping.database import load_database
+    from vtrials.physics.seakeeping.timedomain import seakeeping_vessel
+    db = load_database(_hydro_path(scn.vessel))
+    comp = field.components
+    keep = (comp[:, 1] >= 0.5 * db.omega[0]) & (comp[:, 1] <= db.omega[-1])
+    var = float(np.sum(comp[:, 0] ** 2))
+    dropped = float(np.sum(comp[~keep, 0] ** 2)) / var if var > 0.0 else 0.0
+    v, _ = seakeeping_vessel(scn.vessel, db, comp[keep], scn.head.timestep_s if dt is None else dt, model=model)
+    return v, dropped

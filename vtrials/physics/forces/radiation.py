@@ -1,0 +1,90 @@
+"""Radiation memory force: the state-space approximation of the Cummins convolution.
+
+μ = C_r x with ẋ = A_r x + B_r ξ̇ (:mod:`vtrials.physics.seakeeping.radiation`), advanced by the
+exact zero-order hold x⁺ = Φ x + Γ ξ̇ over the simulator's step (Φ, Γ packed for that step). The force
+is −μ, in the seakeeping frame (x along the heading, horizontal; z down), turned into body axes with
+the ship's roll and pitch. Input ξ̇: the perturbation velocities of the seakeeping DOFs in that frame
+(heave: the vertical velocity of the origin; roll, pitch: the body rates p, q, equal to first order),
+zero mean about the maneuvering motion, so the memory adds no steady force to the maneuvering model
+(and K̂(0) = 0 besides). Using the body heave velocity w instead would add −Uθ at forward speed, a
+speed coupling the zero-speed RAO does not have. The A∞ part of
+the radiation force is in the added-mass matrix of the dynamics' exact solve, not here.
+
+Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n), h]; states: x (n),
+then scratch: n for the new x and n_dofs for the inputs (held as component states: no allocation per step).
+A simulator whose step is not h gets a non-finite force (and stops with a status) rather than a wrong memory.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from vtrials.physics.forces import context as L
+from vtrials.physics.forces.registry import register
+
+
+def pack(model, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """(parameter block, initial states) for :class:`RadiationModel` ``model`` and step ``dt`` [s]."""
+    Phi, Gam = model.discretize(dt)
+    dofs = np.array(model.dofs)
+    n = model.n_states
+    p = np.concatenate([[n, dofs.size], dofs.astype(float), Phi.ravel(), Gam[:, dofs].ravel(),
+                        model.C[dofs].ravel(), [dt]])
+    return p.astype(np.float64), np.zeros(2 * n + dofs.size)   # x, then scratch (no allocation per step)
+
+
+@nb.njit(cache=True, fastmath=False)
+def radiation_kernel(p, s, env, ctx, aux, w):
+    n = int(p[0])
+    m = int(p[1])
+    o_phi = 2 + m
+    o_gam = o_phi + n * n
+    o_c = o_gam + n * m
+    if abs(ctx[L.DT] - p[o_c + m * n]) > 1e-9 * p[o_c + m * n]:
+        # discretised for another step: fail loudly (the simulator stops on a non-finite force)
+        for j in range(6):
+            w[j] = math.nan
+        return
+    for j in range(6):
+        w[j] = 0.0
+    for r in range(m):
+        acc = 0.0
+        for k in range(n):
+            acc += p[o_c + r * n + k] * s[k]
+        w[int(p[2 + r])] = -acc
+    # seakeeping frame (x along the heading, horizontal; z down) → body axes: f_body = Rᵀ Rz(ψ) f
+    psi = ctx[L.EUL + 2]
+    cp = math.cos(psi)
+    sp = math.sin(psi)
+    for o in (0, 3):
+        fn = cp * w[o] - sp * w[o + 1]
+        fe = sp * w[o] + cp * w[o + 1]
+        fd = w[o + 2]
+        for k in range(3):
+            w[o + k] = ctx[L.ROT + k] * fn + ctx[L.ROT + 3 + k] * fe + ctx[L.ROT + 6 + k] * fd
+    # inputs: seakeeping-frame perturbation velocities: heave = vertical (down) velocity of the origin,
+    # roll and pitch rates (body rates, equal to first order); surge/sway/yaw if listed: body values
+    u = s[2 * n:2 * n + m]
+    for r in range(m):
+        d = int(p[2 + r])
+        if d == 2:
+            u[r] = ctx[L.ROT + 6] * ctx[L.NU] + ctx[L.ROT + 7] * ctx[L.NU + 1] + ctx[L.ROT + 8] * ctx[L.NU + 2]
+        else:
+            u[r] = ctx[L.NU_R + d]
+    # advance: x⁺ = Φ x + Γ u (u held over the step), through the scratch part of the states
+    tmp = s[n:2 * n]
+    for k in range(n):
+        acc = 0.0
+        for l in range(n):
+            acc += p[o_phi + k * n + l] * s[l]
+        for r in range(m):
+            acc += p[o_gam + k * m + r] * u[r]
+        tmp[k] = acc
+    for k in range(n):
+        s[k] = tmp[k]
+
+
+RADIATION_COMPONENT = register("radiation", radiation_kernel)

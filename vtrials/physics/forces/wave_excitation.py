@@ -1,0 +1,118 @@
+"""First-order wave excitation from a ship's BEM database, summed over the components of a seaway.
+
+For wave component j (amplitude a_j, frequency ω_j, wavenumber k_j, direction of travel μ_j from
+north clockwise, phase ε_j; :mod:`vtrials.physics.environment.waves`) the force on the ship is
+(database convention, :mod:`vtrials.physics.seakeeping.database`)
+
+    F(t) = Σ_j a_j Re{X(ω_j, β_j) e^{iθ_j}},   θ_j = ω_j t − k_j (x cos μ_j + y sin μ_j) + ε_j,
+
+with (x north, y east) the ship's origin where it is now (its displaced position: the encounter
+frequency comes out of the motion) and β_j = μ_j − ψ the heading of the component relative to the
+ship at this step (ψ the ship's heading). The sums are in the seakeeping frame (x along the heading,
+horizontal; z down) and turned into body axes with the ship's roll and pitch. X over the database's headings is tabulated per component at
+its own frequency when the block is packed; the kernel interpolates linearly in β (mirror image
+X(−β) = S X(β), S = diag(1, −1, 1, −1, 1, −1) for β < 0). Body axes at the origin; the zero-speed
+excitation at the wave frequency (see :mod:`vtrials.physics.seakeeping.rao` for what that neglects).
+
+Parameter block: [n, nβ, mask(6), headings(nβ), then per component a, ω, k, cos μ, sin μ, ε and the
+table Re X, Im X (nβ × 6 each)]. ``mask`` selects the DOFs that receive the force (1/0).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from vtrials.errors import InputError
+from vtrials.physics.forces import context as L
+from vtrials.physics.forces.registry import register
+
+HEAD = 8
+
+
+def pack(db, components: np.ndarray, dofs=(0, 1, 2, 3, 4, 5)) -> np.ndarray:
+    """Parameter block for database ``db`` and wave components (n, 6) [a, ω, k, cos μ, sin μ, ε]."""
+    comp = np.asarray(components, dtype=np.float64)
+    if comp.ndim != 2 or comp.shape[1] != 6 or not np.all(np.isfinite(comp)):
+        raise InputError("waves", "components", f"must be a finite (n, 6) array, got shape {comp.shape}")
+    h = np.asarray(db.headings, dtype=float)
+    if h.size < 2 or abs(h[0]) > 1e-9 or abs(h[-1] - math.pi) > 1e-9 or np.ptp(np.diff(h)) > 1e-9:
+        raise InputError(db.attrs.get("_path", "database"), "heading",
+                         "wave_excitation needs equally spaced headings from 0 to pi")
+    if comp.size and (comp[:, 1].min() < db.omega[0] * 0.5 or comp[:, 1].max() > db.omega[-1]):
+        raise InputError("waves", "omega", f"components span {comp[:, 1].min():.3g}–{comp[:, 1].max():.3g} "
+                         f"rad/s; the database covers {db.omega[0]:.3g}–{db.omega[-1]:.3g} rad/s")
+    nb_ = h.size
+    mask = np.zeros(6)
+    mask[list(dofs)] = 1.0
+    out = [np.array([comp.shape[0], nb_]), mask, h]
+    for a, w, k, cm, sm, eps in comp:
+        X = np.empty((nb_, 6), dtype=complex)
+        for j in range(6):
+            X[:, j] = [np.interp(w, db.omega, db.X[:, ib, j].real) + 1j * np.interp(w, db.omega, db.X[:, ib, j].imag)
+                       for ib in range(nb_)]
+        out += [np.array([a, w, k, cm, sm, eps]), X.real.ravel(), X.imag.ravel()]
+    return np.concatenate(out).astype(np.float64)
+
+
+@nb.njit(cache=True, fastmath=False)
+def excitation_kernel(p, s, env, ctx, aux, w):
+    n = int(p[0])
+    nbeta = int(p[1])
+    h0 = 2 + 6
+    dh = p[h0 + 1] - p[h0]
+    base = h0 + nbeta
+    stride = 6 + 12 * nbeta
+    x = ctx[L.POS]
+    y = ctx[L.POS + 1]
+    t = ctx[L.TIME]
+    psi = ctx[L.EUL + 2]
+    cp = math.cos(psi)
+    sp = math.sin(psi)
+    for j in range(6):
+        w[j] = 0.0
+    for c in range(n):
+        q = base + c * stride
+        a = p[q]
+        om = p[q + 1]
+        k = p[q + 2]
+        cm = p[q + 3]
+        sm = p[q + 4]
+        th = om * t - k * (x * cm + y * sm) + p[q + 5]
+        ct = a * math.cos(th)
+        st = a * math.sin(th)
+        # β = μ − ψ in (−π, π] from cos/sin of the difference (one atan2, no further trig)
+        b = math.atan2(sm * cp - cm * sp, cm * cp + sm * sp)
+        sgn = 1.0
+        if b < 0.0:
+            b = -b
+            sgn = -1.0
+        f = b / dh
+        i0 = int(f)
+        if i0 >= nbeta - 1:
+            i0 = nbeta - 2
+        fr = f - i0
+        re0 = q + 6
+        im0 = re0 + 6 * nbeta
+        for d in range(6):
+            xr = (1.0 - fr) * p[re0 + 6 * i0 + d] + fr * p[re0 + 6 * (i0 + 1) + d]
+            xi = (1.0 - fr) * p[im0 + 6 * i0 + d] + fr * p[im0 + 6 * (i0 + 1) + d]
+            m = 1.0
+            if sgn < 0.0 and (d == 1 or d == 3 or d == 5):
+                m = -1.0
+            w[d] += m * (xr * ct - xi * st)
+    for d in range(6):
+        w[d] *= p[2 + d]
+    # the sums are in the seakeeping frame (x along the heading, horizontal; z down): to body axes,
+    # f_body = Rᵀ Rz(ψ) f, so that a heeled or trimmed ship is not pushed sideways by a vertical load
+    for o in (0, 3):
+        fn = cp * w[o] - sp * w[o + 1]
+        fe = sp * w[o] + cp * w[o + 1]
+        fd = w[o + 2]
+        for k in range(3):
+            w[o + k] = ctx[L.ROT + k] * fn + ctx[L.ROT + 3 + k] * fe + ctx[L.ROT + 6 + k] * fd
+
+
+WAVE_EXCITATION_COMPONENT = register("wave_excitation", excitation_kernel)
