@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from vtrials.physics.environment.waves import Waves, kinematics, realize
-from vtrials.reduce.directional import bulk_from_directional, fourier_coefficients, mem, mlm, spreading_moments
+from vtrials.reduce.directional import (bulk_from_directional, fourier_coefficients, imlm, mem, mlm,
+                                        spreading_moments)
 
 FS = 2.0
 
@@ -49,7 +50,7 @@ def test_buoy_recovers_mean_direction_and_spread(direction_from_deg, s, channels
     hs, mu1, sig1 = fc.bulk(0.6 * wp, 3.0 * wp)
     mu = np.linspace(0.0, 2 * math.pi, 360, endpoint=False)
     res = {"fourier": (mu1, sig1)}
-    for name, method in (("MLM", mlm), ("MEM", mem)):
+    for name, method in (("MLM", mlm), ("IMLM", imlm), ("MEM", mem)):
         D = method(fc.a1[band], fc.b1[band], fc.a2[band], fc.b2[band], mu)
         assert np.allclose(np.sum(D, axis=1) * (2 * math.pi / mu.size), 1.0)
         res[name] = bulk_from_directional(fc.omega[band], fc.S[band], D, mu)
@@ -57,11 +58,14 @@ def test_buoy_recovers_mean_direction_and_spread(direction_from_deg, s, channels
         print(f"{channels} s={s} from {direction_from_deg}°: {name}: mean error "
               f"{math.degrees(_angle_diff(m, mu_true)):.1f}°, spread {math.degrees(sg):.1f}° vs "
               f"{math.degrees(sig_true):.1f}° ({sg / sig_true - 1:+.3f})")
-    for name in ("fourier", "MLM", "MEM"):
+    for name in ("fourier", "MLM", "IMLM", "MEM"):
         m, sg = res[name]
         assert math.degrees(_angle_diff(m, mu_true)) < 10.0, name
-    for name in ("fourier", "MEM"):  # MEM reproduces a₁, b₁ exactly; MLM's spread is reported, not asserted
+    for name in ("fourier", "MEM"):  # MEM reproduces a₁, b₁ exactly
         assert res[name][1] == pytest.approx(sig_true, rel=0.20), name
+    # the MLM spreads too wide (+18 to +50 % here); the iteration narrows it (+3 to +30 %), not always within 20 %
+    assert res["MLM"][1] > sig_true
+    assert abs(res["IMLM"][1] / sig_true - 1.0) < abs(res["MLM"][1] / sig_true - 1.0)
 
 
 def test_mem_reproduces_the_coefficients_and_mlm_peaks_at_the_mean():
