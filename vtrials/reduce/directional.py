@@ -1,0 +1,172 @@
+"""Directional wave spectra from a heave–pitch–roll buoy (η, ∂η/∂x, ∂η/∂y) or an (η, u, v) buoy.
+
+Directions μ [rad] are where the waves go TOWARDS, from north (x) clockwise to east (y), as in
+:mod:`vtrials.physics.environment.waves`; the nautical "from" direction is μ + π.
+
+1. First five Fourier coefficients (Longuet-Higgins, Cartwright & Smith 1963, "Observations of the
+   directional spectrum of sea waves using the motions of a floating buoy"), from the cross-spectra
+   G_mn = E[X_m* X_n] (one-sided, :func:`vtrials.reduce.spectra.cross_spectral_matrix`) of the channels
+   1 = η, 2 = p, 3 = q. With p, q the slopes ∂η/∂x, ∂η/∂y (in quadrature with η) or the horizontal
+   velocities u, v (in phase):
+       a₁ = s Im G₁₂ / √(G₁₁(G₂₂ + G₃₃)),  b₁ = s Im G₁₃ / √(…)   (slopes, s = −1; velocities use Re, s = 1)
+       a₂ = (G₂₂ − G₃₃)/(G₂₂ + G₃₃),  b₂ = 2 Re G₂₃/(G₂₂ + G₃₃),
+   the moments ∫D(μ)(cos μ, sin μ, cos 2μ, sin 2μ) dμ of the spreading function D at each ω.
+   Mean direction μ₁ = atan2(b₁, a₁), circular spread σ₁ = √(2(1 − √(a₁² + b₁²))) (Kuik, van Vledder
+   & Holthuijsen 1988, J. Phys. Oceanogr. 18:1020); bulk values from the S-weighted a₁, b₁.
+2. Maximum-likelihood method (Capon 1969; Isobe, Kondo & Horikawa 1984, Proc. 19th ICCE) written on
+   the normalised co-spectral matrix of (1, cos μ, sin μ), which the five coefficients fix:
+       Φ = [[1, a₁, b₁], [a₁, (1 + a₂)/2, b₂/2], [b₁, b₂/2, (1 − a₂)/2]],  D(μ) ∝ 1/(hᵀ Φ⁻¹ h),
+   h = (1, cos μ, sin μ), normalised to ∫D dμ = 1.
+3. Maximum-entropy method (Lygre & Krogstad 1986, J. Phys. Oceanogr. 16:2052–2060), c₁ = a₁ + i b₁,
+   c₂ = a₂ + i b₂: φ₁ = (c₁ − c₂ c₁*)/(1 − |c₁|²), φ₂ = c₂ − c₁ φ₁,
+       D(μ) = (1/2π)(1 − φ₁ c₁* − φ₂ c₂*)/|1 − φ₁ e^{−iμ} − φ₂ e^{−2iμ}|²,
+   which reproduces all five coefficients exactly.
+The extended maximum-entropy principle (EMEP, Hashimoto 1997) is not implemented here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from vtrials.errors import InputError
+from vtrials.reduce.spectra import cross_spectral_matrix
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclasses.dataclass(frozen=True)
+class FourierCoefficients:
+    """S(ω) [m² s/rad] and the directional moments a₁, b₁, a₂, b₂ per ω [rad/s] (module doc)."""
+
+    omega: np.ndarray
+    S: np.ndarray
+    a1: np.ndarray
+    b1: np.ndarray
+    a2: np.ndarray
+    b2: np.ndarray
+    dof: float
+
+    @property
+    def mean_direction(self) -> np.ndarray:
+        """μ₁(ω) = atan2(b₁, a₁) [rad], towards, in [0, 2π)."""
+        return np.arctan2(self.b1, self.a1) % TWO_PI
+
+    @property
+    def spread(self) -> np.ndarray:
+        """σ₁(ω) = √(2(1 − r₁)) [rad]."""
+        return np.sqrt(2.0 * (1.0 - np.clip(np.hypot(self.a1, self.b1), 0.0, 1.0)))
+
+    def bulk(self, omega_lo: float = 0.0, omega_hi: float = math.inf) -> tuple[float, float, float]:
+        """(H_s [m], mean direction towards [rad], σ₁ [rad]) over a band, a₁ and b₁ weighted by S."""
+        m = (self.omega >= omega_lo) & (self.omega <= omega_hi) & np.isfinite(self.a1)
+        w, S = self.omega[m], self.S[m]
+        m0 = np.trapezoid(S, w)
+        A1 = np.trapezoid(S * self.a1[m], w) / m0
+        B1 = np.trapezoid(S * self.b1[m], w) / m0
+        return 4.0 * math.sqrt(m0), math.atan2(B1, A1) % TWO_PI, math.sqrt(2.0 * (1.0 - min(1.0, math.hypot(A1, B1))))
+
+
+def fourier_coefficients(eta, p, q, fs: float, nperseg: int, channels: str = "slopes") -> FourierCoefficients:
+    """First five Fourier coefficients from records η [m] and p, q (slopes [–] or velocities [m/s]) at fs [Hz].
+
+    ``channels``: "slopes" (heave–pitch–roll buoy: p = ∂η/∂x north, q = ∂η/∂y east) or "velocities"
+    (u north, v east: a GPS or current-meter buoy).
+    """
+    if channels not in ("slopes", "velocities"):
+        raise InputError("record", "channels", f"{channels!r}: expected 'slopes' or 'velocities'")
+    G = cross_spectral_matrix([eta, p, q], fs, nperseg)
+    C = G.S
+    g11 = C[:, 0, 0].real
+    g22 = C[:, 1, 1].real
+    g33 = C[:, 2, 2].real
+    with np.errstate(invalid="ignore", divide="ignore"):
+        den = np.sqrt(g11 * (g22 + g33))
+        if channels == "slopes":
+            a1 = -C[:, 0, 1].imag / den
+            b1 = -C[:, 0, 2].imag / den
+        else:
+            a1 = C[:, 0, 1].real / den
+            b1 = C[:, 0, 2].real / den
+        a2 = (g22 - g33) / (g22 + g33)
+        b2 = 2.0 * C[:, 1, 2].real / (g22 + g33)
+    return FourierCoefficients(G.omega, g11, a1, b1, a2, b2, G.dof)
+
+
+def _normalise(D, mu):
+    dmu = TWO_PI / mu.size
+    return D / (np.sum(D, axis=-1, keepdims=True) * dmu)
+
+
+def mlm(a1, b1, a2, b2, mu):
+    """Maximum-likelihood spreading D(μ) [1/rad] on a uniform grid mu [rad] over one turn (module doc, 2).
+
+    Coefficient arrays of shape (n,) give D of shape (n, len(mu)).
+    """
+    a1, b1, a2, b2 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (a1, b1, a2, b2))
+    mu = np.asarray(mu, dtype=float)
+    Phi = np.empty(a1.shape + (3, 3))
+    Phi[..., 0, 0] = 1.0
+    Phi[..., 0, 1] = Phi[..., 1, 0] = a1
+    Phi[..., 0, 2] = Phi[..., 2, 0] = b1
+    Phi[..., 1, 1] = 0.5 * (1.0 + a2)
+    Phi[..., 2, 2] = 0.5 * (1.0 - a2)
+    Phi[..., 1, 2] = Phi[..., 2, 1] = 0.5 * b2
+    inv = np.linalg.pinv(Phi)
+    h = np.stack([np.ones_like(mu), np.cos(mu), np.sin(mu)])  # (3, n_mu)
+    quad = np.einsum("im,...ij,jm->...m", h, inv, h)
+    D = 1.0 / np.maximum(quad, 1e-12)
+    return _normalise(D, mu)
+
+
+def imlm(a1, b1, a2, b2, mu, iterations: int = 30, relax: float = 1.0):
+    """Iterated maximum-likelihood spreading (Pawka 1983, J. Geophys. Res. 88:2653; Oltman-Shay & Guza 1984,
+    J. Phys. Oceanogr. 14:1800) [1/rad] on the uniform grid mu [rad].
+
+    The MLM broadens the spreading: MLM(moments of D) ≠ D. Starting from D₀ = MLM of the measured
+    coefficients, D_{n+1} = max(0, D_n + λ (D₀ − MLM(moments of D_n))), renormalised — the D whose MLM
+    image matches the measured one.
+    """
+    mu = np.asarray(mu, dtype=float)
+    D0 = mlm(a1, b1, a2, b2, mu)
+    D = D0.copy()
+    dmu = TWO_PI / mu.size
+    c1, s1, c2, s2 = np.cos(mu), np.sin(mu), np.cos(2 * mu), np.sin(2 * mu)
+    for _ in range(iterations):
+        m = [np.sum(D * f, axis=-1) * dmu for f in (c1, s1, c2, s2)]
+        D = _normalise(np.maximum(D + relax * (D0 - mlm(*m, mu)), 0.0), mu)
+    return D
+
+
+def mem(a1, b1, a2, b2, mu):
+    """Maximum-entropy spreading D(μ) [1/rad] (Lygre & Krogstad 1986; module doc, 3) on the grid mu [rad]."""
+    a1, b1, a2, b2 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (a1, b1, a2, b2))
+    mu = np.asarray(mu, dtype=float)
+    c1 = (a1 + 1j * b1)[:, None]
+    c2 = (a2 + 1j * b2)[:, None]
+    p1 = (c1 - c2 * np.conj(c1)) / (1.0 - np.abs(c1) ** 2)
+    p2 = c2 - c1 * p1
+    e1 = np.exp(-1j * mu)[None, :]
+    num = (1.0 - p1 * np.conj(c1) - p2 * np.conj(c2)).real
+    D = num / (TWO_PI * np.abs(1.0 - p1 * e1 - p2 * e1 * e1) ** 2)
+    return _normalise(np.maximum(D, 0.0), mu)
+
+
+def spreading_moments(D, mu) -> tuple[np.ndarray, np.ndarray]:
+    """(mean direction [rad], σ₁ [rad]) of spreading functions D (…, n_mu) on a uniform grid over one turn."""
+    dmu = TWO_PI / np.asarray(mu).size
+    a1 = np.sum(D * np.cos(mu), axis=-1) * dmu
+    b1 = np.sum(D * np.sin(mu), axis=-1) * dmu
+    return np.arctan2(b1, a1) % TWO_PI, np.sqrt(2.0 * (1.0 - np.clip(np.hypot(a1, b1), 0.0, 1.0)))
+
+
+def bulk_from_directional(omega, S, D, mu) -> tuple[float, float]:
+    """(mean direction [rad], σ₁ [rad]) of S(ω) D(ω, μ) over the band given (S-weighted first moments)."""
+    dmu = TWO_PI / np.asarray(mu).size
+    E = np.asarray(S)[:, None] * D
+    A1 = np.trapezoid(np.sum(E * np.cos(mu), axis=-1) * dmu, omega)
+    B1 = np.trapezoid(np.sum(E * np.sin(mu), axis=-1) * dmu, omega)
+    m0 = np.trapezoid(S, omega)
+    return math.atan2(B1, A1) % TWO_PI, math.sqrt(2.0 * (1.0 - min(1.0, math.hypot(A1, B1) / m0)))
