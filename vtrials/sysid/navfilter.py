@@ -35,7 +35,7 @@ class ImuNoise:
     gyro_sigma: float = 3e-4          # white noise of one yaw-rate sample, rad/s
     accel_bias_rw: float = 1e-5       # accelerometer bias random walk, m/s² /√s
     gyro_bias_rw: float = 1e-6        # gyro bias random walk, rad/s /√s
-    jerk_psd: float = 1e-4            # white yaw jerk spectral density, (rad/s³)² s
+    jerk_psd: float = 1e-5            # white yaw jerk spectral density, (rad/s³)² s
     accel_bias0: float = 0.01         # prior σ of the accelerometer biases, m/s²
     gyro_bias0: float = 1e-3          # prior σ of the gyro bias, rad/s
 
