@@ -5,7 +5,8 @@ heading (rad, clockwise from north), ``u, v`` body velocity, ``r`` yaw rate, ``r
 acceleration, ``b_fx, b_fy`` accelerometer biases (m/s²), ``b_g`` gyro bias (rad/s).
 
 Process (strapdown in the plane, IMU at the reference point, ship level): u̇ = f_x − b_fx + r v,
-v̇ = f_y − b_fy − r u (specific force f measured by the IMU is the process input), ṙ = rdot,
+v̇ = f_y − b_fy − r u (specific force f measured by the IMU is the process input, integrated by the
+midpoint rule with the step's mean specific force), ṙ = rdot,
 rdot driven by white jerk (integrated random walk, Bar-Shalom, Li & Kirubarajan 2001 §6.2),
 biases are random walks. The z-gyro is a measurement at the IMU rate: r_m = r + b_g + noise.
 Aiding: position fixes (GNSS / range positioning), body velocity (Doppler log: u, v), surge (EM log:
@@ -70,6 +71,16 @@ class NavSolution:
     def sigma(self, name: str) -> np.ndarray:
         i = STATES.index(name)
         return np.sqrt(self.P[:, i, i])
+
+
+def _deriv(x, f):
+    """Time derivative of the state for specific force f = (f_x, f_y)."""
+    psi, u, v, r = x[2], x[3], x[4], x[5]
+    c, sn = np.cos(psi), np.sin(psi)
+    out = np.zeros_like(x)
+    out[0], out[1], out[2] = u * c - v * sn, u * sn + v * c, r
+    out[3], out[4], out[5] = f[0] - x[7] + r * v, f[1] - x[8] - r * u, x[6]
+    return out
 
 
 def _check(t, f, g, aiding):
@@ -158,7 +169,7 @@ def smooth(t_imu, specific_force, gyro_rate, aiding, noise: ImuNoise = ImuNoise(
         psi, u, v, r, rd = x[2], x[3], x[4], x[5], x[6]
         pm = psi + 0.5 * r * dt
         c, sn = np.cos(pm), np.sin(pm)
-        ax, ay = f[k, 0] - x[7] + r * v, f[k, 1] - x[8] - r * u
+        fm = 0.5 * (f[k] + f[k + 1])
         F = I.copy()
         F[0, 2], F[0, 3], F[0, 4], F[0, 5] = dt * (-u * sn - v * c), dt * c, -dt * sn, dt * 0.5 * dt * (-u * sn - v * c)
         F[1, 2], F[1, 3], F[1, 4], F[1, 5] = dt * (u * c - v * sn), dt * sn, dt * c, dt * 0.5 * dt * (u * c - v * sn)
@@ -166,13 +177,8 @@ def smooth(t_imu, specific_force, gyro_rate, aiding, noise: ImuNoise = ImuNoise(
         F[3, 4], F[3, 5], F[3, 7] = dt * r, dt * v, -dt
         F[4, 3], F[4, 5], F[4, 8] = -dt * r, -dt * u, -dt
         F[5, 6] = dt
-        x = x.copy()
-        x[0] += dt * (u * c - v * sn)
-        x[1] += dt * (u * sn + v * c)
-        x[2] += dt * r + 0.5 * dt * dt * rd
-        x[3] += dt * ax
-        x[4] += dt * ay
-        x[5] += dt * rd
+        # midpoint rule (RK2); specific force at the step's start and mean over the step
+        x = x + dt * _deriv(x + 0.5 * dt * _deriv(x, f[k]), fm)
         Q = np.zeros((n, n))
         Q[3, 3] = Q[4, 4] = (noise.accel_sigma * dt)**2
         qj = noise.jerk_psd
