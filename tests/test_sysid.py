@@ -212,7 +212,7 @@ def test_noisy_cross_validation_and_selection(truths):
 def test_output_error_refinement(truths):
     """LM output-error refinement of the linear derivatives against Doppler u, v and gyro r from a
     regression start: within 10 % of the truth, residuals at the noise level, and the 2σ intervals
-    from the Jacobian hold the truth for at least 3 of the 4 coefficients."""
+    from the Jacobian (coloured-residual correction) hold the truth for at least 3 of the 4."""
     segs, mans, _ = _reconstruct(truths[:2] + truths[3:4], np.random.default_rng(np.random.SeedSequence(5)))
     start = rg.coefficients(rg.identify(SHIP, segs, "mmg", select=True))
     res = oe.refine(SHIP, start, mmg.LINEAR, mans, max_nfev=8)

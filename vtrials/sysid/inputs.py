@@ -75,7 +75,7 @@ def mls(order: int, seed: int = 1) -> np.ndarray:
     for i in range(out.size):
         bit = 0
         for t in _TAPS[order]:
-            bit ^= (state >> (t - 1)) & 1
+            bit ^= (state >> (order - t)) & 1
         out[i] = 1.0 if state & 1 else -1.0
         state = (state >> 1) | (bit << (order - 1))
     return out

@@ -107,23 +107,35 @@ def simulate(ship, coeffs: dict, man: Maneuver, t_eval) -> np.ndarray:
     return simulate_batch(ship, terms, np.array([[coeffs[t] for t in terms]]), man, t_eval)[0]
 
 
-def _residuals_batch(ship, terms, C, maneuvers):
-    """Weighted residuals (P, m) for P coefficient sets over all maneuvers and channels."""
+def _residuals_batch(ship, terms, C, maneuvers, rtol=1e-5, atol=1e-7, bounds=None):
+    """Weighted residuals (P, m) for P coefficient sets over all maneuvers and channels; the start
+    index of each (maneuver, channel) block is appended to ``bounds`` if given."""
     out = []
     for man in maneuvers:
         times = np.unique(np.concatenate([np.asarray(v[0], float) for v in man.outputs.values()]))
-        S = simulate_batch(ship, terms, C, man, times)
+        S = simulate_batch(ship, terms, C, man, times, rtol, atol)
         for ch, (tc, z, sg) in man.outputs.items():
             k = np.searchsorted(times, tc)
             e = S[:, CHANNELS.index(ch), k] - np.asarray(z, float)[None, :]
             if ch == "psi":
                 e = (e + np.pi) % (2 * np.pi) - np.pi
+            if bounds is not None:
+                bounds.append(sum(o.shape[1] for o in out))
             out.append(e / sg)
+    if bounds is not None:
+        bounds.append(sum(o.shape[1] for o in out))
     return np.concatenate(out, axis=1)
 
 
-def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfev: int = 20) -> Refined:
-    """Levenberg–Marquardt refinement of the ``free`` coefficients (others held at ``coeffs0``)."""
+def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfev: int = 20,
+           lags: int = 20, rtol: float = 1e-5, atol: float = 1e-7) -> Refined:
+    """Levenberg–Marquardt refinement of the ``free`` coefficients (others held at ``coeffs0``).
+
+    Covariance: (JᵀJ)⁻¹ M (JᵀJ)⁻¹ with M the Newey–West sum of J_tᵀ e_t e_{t−l} J_{t−l} over
+    ``lags`` samples within each (maneuver, channel) record — the coloured-residual correction of
+    Morelli & Klein (1997), J. Guid. Control Dyn. 20(4):796 — since output-error residuals are
+    correlated in time; ``lags = 0`` gives the white-residual s² (JᵀJ)⁻¹ (up to the s² estimate).
+    ``rtol``/``atol``: integration tolerances of the model."""
     terms = tuple(coeffs0)
     free = tuple(free)
     for f in free:
@@ -151,7 +163,7 @@ def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfe
             C = np.repeat(full(p)[None, :], len(free) + 1, axis=0)
             for i, j in enumerate(jf):
                 C[i + 1, j] += h[i]
-            R = _residuals_batch(ship, terms, C, maneuvers)
+            R = _residuals_batch(ship, terms, C, maneuvers, rtol, atol)
             cache.clear()
             cache[key] = (R[0], ((R[1:] - R[0]) / h[:, None]).T)
         return cache[key]
@@ -159,8 +171,18 @@ def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfe
     res = least_squares(lambda p: batch(p)[0], p0, jac=lambda p: batch(p)[1], method="lm",
                         max_nfev=max_nfev, x_scale="jac")
     r, J = batch(res.x)
+    bounds: list = []
+    _residuals_batch(ship, terms, full(res.x)[None, :], maneuvers, rtol, atol, bounds)
     m, p = r.size, len(free)
-    s2 = float(r @ r) / (m - p)
-    cov = s2 * np.linalg.inv(J.T @ J)
+    g = J * r[:, None]
+    M = g.T @ g
+    for lag in range(1, lags + 1):
+        G = np.zeros_like(M)
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            if b - a > lag:
+                G += g[a + lag:b].T @ g[a:b - lag]
+        M += (1.0 - lag / (lags + 1.0)) * (G + G.T)
+    H = np.linalg.inv(J.T @ J)
+    cov = H @ M @ H * m / (m - p)
     out = dict(zip(terms, full(res.x)))
     return Refined(out, free, cov, float(np.sqrt(np.mean(r**2))), int(res.nfev))
