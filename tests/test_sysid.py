@@ -245,3 +245,48 @@ def test_input_designs():
         inputs.zigzags((50.0,))
     with pytest.raises(InputError, match="prbs.order"):
         inputs.mls(3)
+
+
+def _reference_params(coeffs):
+    """The reference integrator's parameter dict with the hull replaced by identified coefficients."""
+    p = dict(P)
+    for k in ("Xvv", "Xvr", "Xrr", "Xvvvv", "Yv", "Yr", "Yvvv", "Yvvr", "Yvrr", "Yrrr", "Nv", "Nr", "Nvvv",
+              "Nvvr", "Nvrr", "Nrrr"):
+        p[k] = 0.0
+    for k, v in coeffs.items():
+        p["R0" if k == "X_0" else k.replace("_", "")] = -v if k == "X_0" else v
+    return p
+
+
+def test_identified_model_predicts_held_back_maneuvers(truths):
+    """Identify (BIC-selected MMG) from zig-zags 10/10, 5/5 and a 20° port turn only; the identified
+    hull, run closed-loop in the reference integrator, predicts the held-back 35° turns (advance and
+    tactical diameter within 5 %) and 20/20 zig-zags (overshoots within 1.5°)."""
+    train = [truths[0], truths[2], truths[4]]
+    segs, _, _ = _reconstruct(train, np.random.default_rng(np.random.SeedSequence(9)))
+    pid = _reference_params(rg.coefficients(rg.identify(SHIP, segs, "mmg", select=True)))
+    kw = dict(rtol=1e-7, atol=1e-8)
+    for d in (35.0, -35.0):
+        a = ref.turning_metrics(ref.simulate(P, U0, N_RPS, ref.TurningCircle(d), 2000.0, **kw), P["L"])
+        b = ref.turning_metrics(ref.simulate(pid, U0, N_RPS, ref.TurningCircle(d), 2000.0, **kw), P["L"])
+        print(f"turn {d:+.0f}: advance {a['advance_m']:.3f} / {b['advance_m']:.3f} m, tactical "
+              f"{a['tactical_diameter_m']:.3f} / {b['tactical_diameter_m']:.3f} m (truth / identified)")
+        assert b["advance_m"] == pytest.approx(a["advance_m"], rel=0.05)
+        assert b["tactical_diameter_m"] == pytest.approx(a["tactical_diameter_m"], rel=0.05)
+    for side in (1, -1):
+        a = ref.zigzag_metrics(ref.simulate(P, U0, N_RPS, ref.ZigZag(20, 20, side), 2000.0, **kw))
+        b = ref.zigzag_metrics(ref.simulate(pid, U0, N_RPS, ref.ZigZag(20, 20, side), 2000.0, **kw))
+        print(f"20/20 side {side:+d}: overshoots {a['first_overshoot_deg']:.2f}, {a['second_overshoot_deg']:.2f}"
+              f" / {b['first_overshoot_deg']:.2f}, {b['second_overshoot_deg']:.2f} deg (truth / identified)")
+        assert abs(b["first_overshoot_deg"] - a["first_overshoot_deg"]) < 1.5
+        assert abs(b["second_overshoot_deg"] - a["second_overshoot_deg"]) < 1.5
+
+
+def test_same_seed_same_result(truths):
+    a, _, _ = _reconstruct(truths[:1], np.random.default_rng(np.random.SeedSequence(3)))
+    b, _, _ = _reconstruct(truths[:1], np.random.default_rng(np.random.SeedSequence(3)))
+    fa = rg.identify(SHIP, a + a, "mmg", select=False)
+    fb = rg.identify(SHIP, b + b, "mmg", select=False)
+    for eq in "XYN":
+        assert fa[eq].coef.tobytes() == fb[eq].coef.tobytes()
+        assert fa[eq].cov.tobytes() == fb[eq].cov.tobytes()
