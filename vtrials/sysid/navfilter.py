@@ -44,12 +44,15 @@ class ImuNoise:
 @dataclasses.dataclass(frozen=True)
 class Aiding:
     """One aiding instrument's record: ``kind`` in position (x, y), velocity (u, v), surge (u),
-    heading (psi); ``t`` (M,) s; ``z`` (M,) or (M, k) SI; ``sigma`` white-noise σ of each component."""
+    heading (psi); ``t`` (M,) s; ``z`` (M,) or (M, k) SI; ``sigma`` white-noise σ of each component;
+    ``lever_arm`` (x, y) of the antenna / log transducer in body axes from the reference point, m
+    (position: p + R(ψ) l; velocity: (u − r l_y, v + r l_x))."""
 
     kind: str
     t: np.ndarray
     z: np.ndarray
     sigma: float
+    lever_arm: tuple = (0.0, 0.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -74,13 +77,32 @@ class NavSolution:
 
 
 def _deriv(x, f):
-    """Time derivative of the state for specific force f = (f_x, f_y)."""
+    """Time derivative of the state for specific force f = (f_x, f_y) at the reference point."""
     psi, u, v, r = x[2], x[3], x[4], x[5]
     c, sn = np.cos(psi), np.sin(psi)
     out = np.zeros_like(x)
     out[0], out[1], out[2] = u * c - v * sn, u * sn + v * c, r
     out[3], out[4], out[5] = f[0] - x[7] + r * v, f[1] - x[8] - r * u, x[6]
     return out
+
+
+def _measure(kind, x, arm):
+    """Predicted measurement h(x) and its Jacobian H for one aiding kind with lever arm (lx, ly)."""
+    lx, ly = arm
+    H = np.zeros((len(_KINDS[kind]), len(STATES)))
+    if kind == "heading":
+        H[0, 2] = 1.0
+        return x[[2]], H
+    if kind == "position":
+        c, sn = np.cos(x[2]), np.sin(x[2])
+        H[0, 0] = H[1, 1] = 1.0
+        H[0, 2], H[1, 2] = -sn * lx - c * ly, c * lx - sn * ly
+        return np.array([x[0] + c * lx - sn * ly, x[1] + sn * lx + c * ly]), H
+    H[0, 3], H[0, 5] = 1.0, -ly
+    if kind == "surge":
+        return x[[3]] - x[5] * ly, H
+    H[1, 4], H[1, 5] = 1.0, lx
+    return np.array([x[3] - x[5] * ly, x[4] + x[5] * lx]), H
 
 
 def _check(t, f, g, aiding):
@@ -108,6 +130,9 @@ def smooth(t_imu, specific_force, gyro_rate, aiding, noise: ImuNoise = ImuNoise(
     ``specific_force`` (N, 2) body f_x, f_y in m/s²; ``gyro_rate`` (N,) rad/s; ``aiding`` a list of
     :class:`Aiding`. ``x0`` initial state (default: first position, heading and velocity fixes, zero
     rates and biases) and ``P0_diag`` its variances (default: the aiding σ², generous rate priors).
+    The IMU must be at the reference point (or its specific force transferred there by the caller):
+    IMU lever arms are not modelled (an attempt with the ṙ × l and r² l terms in the propagation
+    gave large velocity errors in the tests, cause not established, and was removed).
     """
     t, f, g = _check(t_imu, specific_force, gyro_rate, aiding)
     N, n = t.size, len(STATES)
@@ -125,13 +150,15 @@ def smooth(t_imu, specific_force, gyro_rate, aiding, noise: ImuNoise = ImuNoise(
         k = np.where(np.abs(t[k - 1] - ta) <= np.abs(t[k] - ta), k - 1, k)
         inside = (ta >= t[0] - dt_all[0]) & (ta <= t[-1] + dt_all[-1])
         for kk, zz in zip(k[inside], z[inside]):
-            events.setdefault(int(kk), []).append((idx, zz, a.sigma, a.kind))
+            events.setdefault(int(kk), []).append((zz, a.sigma, a.kind, tuple(map(float, a.lever_arm))))
     if x0 is None:
         x0 = np.zeros(n)
-        for a in aiding:
+        x0[5] = g[0]
+        for a in sorted(aiding, key=lambda a: a.kind != "heading"):   # heading first: lever arms
             z = np.asarray(a.z, float).reshape(len(a.t), -1)
             x0[list(_KINDS[a.kind])] = z[0]
-        x0[5] = g[0]
+            h, _ = _measure(a.kind, x0, a.lever_arm)
+            x0[list(_KINDS[a.kind])] += z[0] - h
     x = np.asarray(x0, float).copy()
     if P0_diag is None:
         sig = {i: a.sigma for a in aiding for i in _KINDS[a.kind]}
@@ -152,15 +179,15 @@ def smooth(t_imu, specific_force, gyro_rate, aiding, noise: ImuNoise = ImuNoise(
         K = Ph / s
         x = x + K * (g[k] - x[5] - x[9])
         P = P - np.outer(K, Ph)
-        for idx, zz, sg, kind in events.get(k, ()):
-            ii = list(idx)
-            innov = zz - x[ii]
+        for zz, sg, kind, arm in events.get(k, ()):
+            h, H = _measure(kind, x, arm)
+            innov = zz - h
             if kind == "heading":
                 innov = (innov + np.pi) % (2 * np.pi) - np.pi
-            S = P[np.ix_(ii, ii)] + sg**2 * np.eye(len(ii))
-            K = np.linalg.solve(S, P[ii, :]).T
+            PH = P @ H.T
+            K = np.linalg.solve(H @ PH + sg**2 * np.eye(len(h)), PH.T).T
             x = x + K @ innov
-            P = P - K @ P[ii, :]
+            P = P - K @ PH.T
         P = 0.5 * (P + P.T)
         xf[k], Pf[k] = x, P
         if k == N - 1:
