@@ -68,7 +68,7 @@ def _reconstruct(truths, rng, scale=1.0):
         f, g, aid, rud, noise = _instruments(t, s, d, rng, scale)
         sol = navfilter.smooth(t, f, g, aid, noise)
         n = np.full(t.size, N_RPS)
-        segs.append(rg.Segment(t, sol.state("u"), sol.state("v"), sol.state("r"), *sol.acc.T, rud, n))
+        segs.append(rg.Segment.from_nav(sol, rud, N_RPS))
         k = np.arange(0, t.size, 5)
         vel = aid[1]
         outs = {"u": (vel.t, vel.z[:, 0], vel.sigma), "v": (vel.t, vel.z[:, 1], vel.sigma),
@@ -201,6 +201,29 @@ def test_smoother_with_lever_arms(truths):
     assert np.sqrt(np.mean(np.concatenate(ex)**2)) < 0.5 * NOISE["pos"]
     assert cov > 0.85
     assert cov_acc > 0.85
+
+
+def test_smoother_with_em_log_only(truths):
+    """No Doppler: surge from an EM log (σ 2 % of speed, Froude-scaled), sway from the IMU and the
+    position fixes alone; errors and coverage of u and v over the five maneuvers."""
+    rng = np.random.default_rng(np.random.SeedSequence(31))
+    eu, ev, cu, cv = [], [], [], []
+    for t, s, d in truths:
+        f, g, aid, _, noise = _instruments(t, s, d, rng)
+        pos, vel, head = aid
+        sig_log = 0.02 * U0
+        log = navfilter.Aiding("surge", vel.t, s[3][np.searchsorted(t, vel.t)]
+                               + sig_log * rng.standard_normal(vel.t.size), sig_log)
+        sol = navfilter.smooth(t, f, g, [pos, log, head], noise)
+        for e, c, i in ((eu, cu, 3), (ev, cv, 4)):
+            err = sol.x[:, i] - s[i]
+            e.append(err)
+            c.append(np.abs(err) < 1.96 * np.sqrt(sol.P[:, i, i]))
+    rms_u, rms_v = (float(np.sqrt(np.mean(np.concatenate(e)**2))) for e in (eu, ev))
+    cov_u, cov_v = (float(np.mean(np.concatenate(c))) for c in (cu, cv))
+    print(f"EM log only: u rms {rms_u:.5f} cov {cov_u:.3f}, v rms {rms_v:.5f} cov {cov_v:.3f} m/s")
+    assert rms_u < 0.2 * sig_log and rms_v < 0.2 * NOISE["vel"]
+    assert cov_u > 0.85 and cov_v > 0.85
 
 
 # ---------------------------------------------------------------------------- identification

@@ -36,6 +36,15 @@ class Segment:
     delta: np.ndarray
     n: np.ndarray
 
+    @classmethod
+    def from_nav(cls, sol, delta, n) -> "Segment":
+        """From a :class:`vtrials.sysid.navfilter.NavSolution` and the rudder angle (rad) and shaft
+        rate (1/s) resampled at its instants."""
+        t = np.asarray(sol.t, float)
+        delta, n = (np.broadcast_to(np.asarray(a, float), t.shape).copy() for a in (delta, n))
+        return cls(t, sol.state("u"), sol.state("v"), sol.state("r"), sol.acc[:, 0], sol.acc[:, 1],
+                   sol.acc[:, 2], delta, n)
+
 
 @dataclasses.dataclass(frozen=True)
 class Fit:
