@@ -19,6 +19,8 @@ import numpy as np
 
 from vtrials.errors import InputError
 
+_WHERE = "vtrials.sysid.inputs"
+
 #: Feedback taps of maximum-length shift registers of order 5..10 (Godfrey 1993, Table 3.1).
 _TAPS = {5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7)}
 
@@ -26,7 +28,7 @@ _TAPS = {5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7
 def _amp(field: str, value: float, lo: float = 0.0, hi: float = 45.0) -> float:
     value = float(value)
     if not (lo < abs(value) <= hi):
-        raise InputError("", field, f"{value:g}°; allowed: {lo:g} < |angle| ≤ {hi:g}°")
+        raise InputError(_WHERE, field, f"{value:g}°; allowed: {lo:g} < |angle| ≤ {hi:g}°")
     return value
 
 
@@ -37,7 +39,7 @@ def zigzags(amplitudes_deg=(5.0, 10.0, 20.0), first_sides=(1, -1), executes: int
         a = abs(_amp("zigzag.rudder_deg", a))
         for s in first_sides:
             if s not in (1, -1):
-                raise InputError("", "zigzag.first_side", f"{s}; allowed: 1 (starboard) or -1 (port)")
+                raise InputError(_WHERE, "zigzag.first_side", f"{s}; allowed: 1 (starboard) or -1 (port)")
             out.append(dict(type="zigzag", rudder_deg=s * a, check_deg=a, executes=int(executes)))
     return out
 
@@ -59,7 +61,7 @@ def spiral(sequence_deg=(15.0, 10.0, 5.0, 2.0, 0.0, -2.0, -5.0, -10.0, -15.0), h
     seq = [float(d) for d in sequence_deg]
     for i, d in enumerate(seq):
         if abs(d) > 45.0:
-            raise InputError("", f"spiral.sequence_deg[{i}]", f"{d:g}°; allowed: |angle| ≤ 45°")
+            raise InputError(_WHERE, f"spiral.sequence_deg[{i}]", f"{d:g}°; allowed: |angle| ≤ 45°")
     return dict(type="direct_spiral", sequence_deg=seq, hold_s=float(hold_s))
 
 
@@ -67,10 +69,10 @@ def mls(order: int, seed: int = 1) -> np.ndarray:
     """One period (2^order − 1) of a maximum-length ±1 sequence; ``seed`` (≠ 0 mod 2^order) sets the
     register's start state, i.e. the phase of the sequence."""
     if order not in _TAPS:
-        raise InputError("", "prbs.order", f"{order}; allowed: {min(_TAPS)}..{max(_TAPS)}")
+        raise InputError(_WHERE, "prbs.order", f"{order}; allowed: {min(_TAPS)}..{max(_TAPS)}")
     state = int(seed) % (1 << order)
     if state == 0:
-        raise InputError("", "prbs.seed", f"{seed}; allowed: not a multiple of 2^{order}")
+        raise InputError(_WHERE, "prbs.seed", f"{seed}; allowed: not a multiple of 2^{order}")
     out = np.empty((1 << order) - 1)
     for i in range(out.size):
         bit = 0
@@ -86,7 +88,7 @@ def prbs(rudder_deg: float = 10.0, bit_s: float = 5.0, order: int = 6, seed: int
     instants at which the rudder switches side (first side: the sign of ``rudder_deg``)."""
     a = _amp("prbs.rudder_deg", rudder_deg)
     if not bit_s > 0:
-        raise InputError("", "prbs.bit_s", f"{bit_s:g} s; allowed: > 0")
+        raise InputError(_WHERE, "prbs.bit_s", f"{bit_s:g} s; allowed: > 0")
     seq = mls(order, seed)
     seq = seq * np.sign(a) * seq[0]
     switch = [float(i * bit_s) for i in range(1, seq.size) if seq[i] != seq[i - 1]]

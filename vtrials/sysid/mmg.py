@@ -22,6 +22,8 @@ import numpy as np
 
 from vtrials.errors import InputError
 
+_WHERE = "vtrials.sysid.mmg"
+
 #: Model structures: the candidate terms of each equation.
 STRUCTURES = MappingProxyType({
     # Y&Y (2015) eq. (10)
@@ -119,7 +121,7 @@ def kvlcc2_hull() -> dict[str, float]:
 def _factors(term: str) -> list[tuple[str, bool]]:
     """'Y_v|r|' -> [('v', False), ('r', True)]; 'X_0' -> []."""
     if len(term) < 3 or term[0] not in "XYN" or term[1] != "_":
-        raise InputError("", "term", f"{term!r} is not a hull term; allowed: X_/Y_/N_ followed by "
+        raise InputError(_WHERE, "term", f"{term!r} is not a hull term; allowed: X_/Y_/N_ followed by "
                          "v, r, |v|, |r| factors or 0")
     body, out, i = term[2:], [], 0
     if body == "0":
@@ -132,7 +134,7 @@ def _factors(term: str) -> list[tuple[str, bool]]:
             out.append((body[i + 1], True))
             i += 3
         else:
-            raise InputError("", "term", f"{term!r}: cannot read factor at {body[i:]!r}; allowed "
+            raise InputError(_WHERE, "term", f"{term!r}: cannot read factor at {body[i:]!r}; allowed "
                              "factors: v, r, |v|, |r|")
     return out
 

@@ -24,6 +24,8 @@ import numpy as np
 
 from vtrials.errors import InputError
 
+_WHERE = "vtrials.sysid.navfilter"
+
 STATES = ("x", "y", "psi", "u", "v", "r", "rdot", "b_fx", "b_fy", "b_g")
 _KINDS = {"position": (0, 1), "velocity": (3, 4), "surge": (3,), "heading": (2,)}
 
@@ -108,18 +110,18 @@ def _measure(kind, x, arm):
 def _check(t, f, g, aiding):
     t = np.asarray(t, float)
     if t.ndim != 1 or t.size < 3 or not np.all(np.diff(t) > 0):
-        raise InputError("", "t_imu", f"needs ≥ 3 strictly increasing times, got shape {t.shape}")
+        raise InputError(_WHERE, "t_imu", f"needs ≥ 3 strictly increasing times, got shape {t.shape}")
     f = np.asarray(f, float)
     if f.shape != (t.size, 2):
-        raise InputError("", "specific_force", f"shape {f.shape}; allowed: ({t.size}, 2)")
+        raise InputError(_WHERE, "specific_force", f"shape {f.shape}; allowed: ({t.size}, 2)")
     g = np.asarray(g, float)
     if g.shape != t.shape:
-        raise InputError("", "gyro_rate", f"shape {g.shape}; allowed: ({t.size},)")
+        raise InputError(_WHERE, "gyro_rate", f"shape {g.shape}; allowed: ({t.size},)")
     for a in aiding:
         if a.kind not in _KINDS:
-            raise InputError("", "aiding.kind", f"{a.kind!r}; allowed: {', '.join(_KINDS)}")
+            raise InputError(_WHERE, "aiding.kind", f"{a.kind!r}; allowed: {', '.join(_KINDS)}")
         if not a.sigma > 0:
-            raise InputError("", f"aiding[{a.kind}].sigma", f"{a.sigma}; allowed: > 0")
+            raise InputError(_WHERE, f"aiding[{a.kind}].sigma", f"{a.sigma}; allowed: > 0")
     return t, f, g
 
 
@@ -144,7 +146,7 @@ def smooth(t_imu, specific_force, gyro_rate, aiding, noise: ImuNoise = ImuNoise(
         z = np.asarray(a.z, float).reshape(ta.size, -1)
         idx = _KINDS[a.kind]
         if z.shape[1] != len(idx):
-            raise InputError("", f"aiding[{a.kind}].z", f"{z.shape[1]} components; allowed: {len(idx)}")
+            raise InputError(_WHERE, f"aiding[{a.kind}].z", f"{z.shape[1]} components; allowed: {len(idx)}")
         k = np.searchsorted(t, ta)
         k = np.clip(k, 1, N - 1)
         k = np.where(np.abs(t[k - 1] - ta) <= np.abs(t[k] - ta), k - 1, k)

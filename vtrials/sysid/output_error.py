@@ -5,8 +5,9 @@ is integrated with scipy ``solve_ivp`` from each maneuver's initial state, drive
 rudder angle (linearly interpolated) and shaft rate; the weighted residuals (simulated − measured)/σ
 of the chosen channels are minimised over the free coefficients by Levenberg–Marquardt (Moré 1978,
 MINPACK, via scipy ``least_squares(method="lm")``). The Jacobian comes from forward differences, all
-perturbed parameter sets integrated together as one vector ODE. Parameter covariance: s² (JᵀJ)⁻¹ with
-s² the residual variance (Jategaonkar 2006, "Flight Vehicle System Identification", ch. 4).
+perturbed parameter sets integrated together as one vector ODE. Parameter covariance: the Gauss–Newton
+(JᵀJ)⁻¹ (Jategaonkar 2006, "Flight Vehicle System Identification", ch. 4) with the coloured-residual
+correction of Morelli & Klein (1997) — see :func:`refine`.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from scipy.optimize import least_squares
 
 from vtrials.errors import InputError
 from vtrials.sysid import mmg
+
+_WHERE = "vtrials.sysid.output_error"
 
 CHANNELS = ("x", "y", "psi", "u", "v", "r")
 
@@ -140,11 +143,11 @@ def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfe
     free = tuple(free)
     for f in free:
         if f not in coeffs0:
-            raise InputError("", "free", f"{f!r} is not among the model's terms {terms}")
+            raise InputError(_WHERE, "free", f"{f!r} is not among the model's terms {terms}")
     for man in maneuvers:
         for ch in man.outputs:
             if ch not in CHANNELS:
-                raise InputError("", "outputs", f"{ch!r}; allowed: {', '.join(CHANNELS)}")
+                raise InputError(_WHERE, "outputs", f"{ch!r}; allowed: {', '.join(CHANNELS)}")
     jf = [terms.index(f) for f in free]
     base = np.array([coeffs0[t] for t in terms])
 

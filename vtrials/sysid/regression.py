@@ -21,6 +21,8 @@ import numpy as np
 from vtrials.errors import InputError
 from vtrials.sysid import mmg
 
+_WHERE = "vtrials.sysid.regression"
+
 
 @dataclasses.dataclass(frozen=True)
 class Segment:
@@ -78,7 +80,7 @@ def design(ship: mmg.Ship, segments, eq: str, terms):
     """Stacked regressor matrix and non-dimensional hull-force vector of equation ``eq`` (X, Y or N),
     and the segment boundaries (for the HAC covariance, which must not lag across maneuvers)."""
     if eq not in ("X", "Y", "N"):
-        raise InputError("", "eq", f"{eq!r}; allowed: X, Y, N")
+        raise InputError(_WHERE, "eq", f"{eq!r}; allowed: X, Y, N")
     A, y, bounds = [], [], [0]
     for seg in segments:
         A.append(mmg.regressors(terms, seg.u, seg.v, seg.r, ship.L))
@@ -109,7 +111,7 @@ def ols(A, y, terms, bounds=None, lags: int = 20) -> Fit:
     A, y = np.asarray(A, float), np.asarray(y, float)
     n, p = A.shape
     if n <= p:
-        raise InputError("", "samples", f"{n} samples for {p} terms; allowed: more samples than terms")
+        raise InputError(_WHERE, "samples", f"{n} samples for {p} terms; allowed: more samples than terms")
     bounds = [0, n] if bounds is None else list(bounds)
     coef, *_ = np.linalg.lstsq(A, y, rcond=None)
     e = y - A @ coef
@@ -150,7 +152,7 @@ def identify(ship, segments, structure: str = "mmg", select: bool = True, lags: 
     With ``select`` the terms are chosen by forward BIC selection (constant X_0 and the linear
     derivatives always kept). Returns {eq: Fit}."""
     if structure not in mmg.STRUCTURES:
-        raise InputError("", "structure", f"{structure!r}; allowed: {', '.join(mmg.STRUCTURES)}")
+        raise InputError(_WHERE, "structure", f"{structure!r}; allowed: {', '.join(mmg.STRUCTURES)}")
     out = {}
     for eq, terms in mmg.STRUCTURES[structure].items():
         req = tuple(t for t in terms if t in mmg.LINEAR or t == "X_0")
@@ -174,7 +176,7 @@ def cross_validate(ship, segments, structures=("mmg", "blanke"), select: bool = 
     For each structure: fit on all segments but one, predict the held-out segment's non-dimensional
     hull forces; returns {structure: {eq: RMS prediction error}} over all held-out samples."""
     if len(segments) < 2:
-        raise InputError("", "segments", f"{len(segments)}; allowed: ≥ 2 maneuvers for cross-validation")
+        raise InputError(_WHERE, "segments", f"{len(segments)}; allowed: ≥ 2 maneuvers for cross-validation")
     out = {}
     for s in structures:
         err = {eq: [] for eq in "XYN"}
