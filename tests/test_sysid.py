@@ -110,10 +110,11 @@ def test_inverse_dynamics_recovers_hull_forces_exactly(truths):
 def test_cross_validation_prefers_true_structure_on_exact_data(truths):
     segs = [rg.Segment(t, s[3], s[4], s[5], d[:, 0], d[:, 1], d[:, 2], s[6], np.full(t.size, N_RPS))
             for t, s, d in truths]
-    cv = rg.cross_validate(SHIP, segs, ("mmg", "blanke"), select=False)
+    cv = rg.cross_validate(SHIP, segs, ("mmg", "abkowitz", "blanke"), select=False)
     for eq in "YN":
         assert cv["mmg"][eq] < 1e-6
         assert cv["blanke"][eq] > 100 * cv["mmg"][eq]
+    assert cv["mmg"]["X"] < 1e-6 and cv["abkowitz"]["X"] < 1e-6   # Abkowitz X holds the MMG X terms
 
 
 def test_term_names_and_bad_input():

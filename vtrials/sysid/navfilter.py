@@ -1,6 +1,6 @@
 """Aided inertial navigation in the horizontal plane: extended Kalman filter + RTS smoother.
 
-State (SI): ``x, y`` position of the IMU reference point (earth axes, x north, y east), ``psi``
+State (SI): ``x, y`` position of the reference point (where the IMU is) (earth axes, x north, y east), ``psi``
 heading (rad, clockwise from north), ``u, v`` body velocity, ``r`` yaw rate, ``rdot`` yaw
 acceleration, ``b_fx, b_fy`` accelerometer biases (m/s²), ``b_g`` gyro bias (rad/s).
 
