@@ -1,0 +1,190 @@
+"""Equation-error identification of the hull forces from smoothed states and accelerations.
+
+Inverse dynamics (Y&Y 2015 eq. 4): the measured motion requires total forces X, Y, N; the KNOWN
+parts — rigid-body and added mass, propeller thrust and rudder forces of :class:`vtrials.sysid.mmg.Ship`,
+driven by the recorded rudder angle and shaft speed — are subtracted, leaving the hull forces, which
+are regressed on the hull terms of a model structure, equation by equation (ordinary least squares
+on the non-dimensional forces; Alexandersson et al. 2022, Ocean Eng. 247, "inverse dynamics").
+
+Parameter covariance: heteroskedasticity- and autocorrelation-consistent (Newey & West 1987,
+Econometrica 55:703, Bartlett weights), because residuals of smoothed records are correlated in time.
+Term selection: forward selection by the Bayesian information criterion (Schwarz 1978), with the
+residual correlation accounted for by an effective sample size.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from vtrials.errors import InputError
+from vtrials.sysid import mmg
+
+_WHERE = "vtrials.sysid.regression"
+
+
+@dataclasses.dataclass(frozen=True)
+class Segment:
+    """One maneuver's reconstructed motion (SI): states, accelerations, rudder angle and shaft rate."""
+
+    t: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    r: np.ndarray
+    udot: np.ndarray
+    vdot: np.ndarray
+    rdot: np.ndarray
+    delta: np.ndarray
+    n: np.ndarray
+
+    @classmethod
+    def from_nav(cls, sol, delta, n) -> "Segment":
+        """From a :class:`vtrials.sysid.navfilter.NavSolution` and the rudder angle (rad) and shaft
+        rate (1/s) resampled at its instants."""
+        t = np.asarray(sol.t, float)
+        delta, n = (np.broadcast_to(np.asarray(a, float), t.shape).copy() for a in (delta, n))
+        return cls(t, sol.state("u"), sol.state("v"), sol.state("r"), sol.acc[:, 0], sol.acc[:, 1],
+                   sol.acc[:, 2], delta, n)
+
+
+@dataclasses.dataclass(frozen=True)
+class Fit:
+    """Least-squares fit of one equation: term names, coefficients, their HAC covariance,
+    residual RMS, sample count, effective sample count and BIC."""
+
+    terms: tuple
+    coef: np.ndarray
+    cov: np.ndarray
+    rms: float
+    n: int
+    n_eff: float
+    bic: float
+
+    def sigma(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.cov))
+
+    def as_dict(self) -> dict:
+        return dict(zip(self.terms, self.coef))
+
+
+def hull_force_samples(ship: mmg.Ship, seg: Segment):
+    """Non-dimensional hull forces X'_H, Y'_H, N'_H (inverse dynamics minus known propeller/rudder)."""
+    X, Y, N = mmg.inertial_forces(ship, seg.u, seg.v, seg.r, seg.udot, seg.vdot, seg.rdot)
+    Xpr, Ypr, Npr = mmg.propeller_rudder_forces(ship, seg.u, seg.v, seg.r, seg.delta, seg.n)
+    q = 0.5 * ship.rho * ship.L * ship.d * (seg.u**2 + seg.v**2)
+    return dict(X=(X - Xpr) / q, Y=(Y - Ypr) / q, N=(N - Npr) / (q * ship.L))
+
+
+def design(ship: mmg.Ship, segments, eq: str, terms):
+    """Stacked regressor matrix and non-dimensional hull-force vector of equation ``eq`` (X, Y or N),
+    and the segment boundaries (for the HAC covariance, which must not lag across maneuvers)."""
+    if eq not in ("X", "Y", "N"):
+        raise InputError(_WHERE, "eq", f"{eq!r}; allowed: X, Y, N")
+    A, y, bounds = [], [], [0]
+    for seg in segments:
+        A.append(mmg.regressors(terms, seg.u, seg.v, seg.r, ship.L))
+        y.append(hull_force_samples(ship, seg)[eq])
+        bounds.append(bounds[-1] + len(seg.u))
+    return np.vstack(A), np.concatenate(y), bounds
+
+
+def _hac(A, e, bounds, lags: int):
+    """Newey-West 'meat' Σ_l w_l Σ_t (a_t e_t)(a_{t-l} e_{t-l})ᵀ within each segment."""
+    g = A * e[:, None]
+    S = g.T @ g
+    for lag in range(1, lags + 1):
+        w = 1.0 - lag / (lags + 1.0)
+        G = np.zeros_like(S)
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            if b - a > lag:
+                G += g[a + lag:b].T @ g[a:b - lag]
+        S += w * (G + G.T)
+    return S
+
+
+def ols(A, y, terms, bounds=None, lags: int = 20) -> Fit:
+    """OLS with Newey-West covariance (``lags`` samples) and a BIC on the effective sample size.
+
+    The effective sample size is n (1 − ρ₁)/(1 + ρ₁) with ρ₁ the lag-1 residual autocorrelation
+    (Bartlett 1946's AR(1) approximation)."""
+    A, y = np.asarray(A, float), np.asarray(y, float)
+    n, p = A.shape
+    if n <= p:
+        raise InputError(_WHERE, "samples", f"{n} samples for {p} terms; allowed: more samples than terms")
+    bounds = [0, n] if bounds is None else list(bounds)
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    e = y - A @ coef
+    AtA_inv = np.linalg.pinv(A.T @ A)
+    cov = AtA_inv @ _hac(A, e, bounds, lags) @ AtA_inv * n / (n - p)
+    rho = float(np.clip(np.sum(e[1:] * e[:-1]) / np.sum(e * e), 0.0, 0.999))
+    n_eff = n * (1 - rho) / (1 + rho)
+    rss = float(e @ e)
+    bic = n_eff * np.log(rss / n) + p * np.log(n_eff)
+    return Fit(tuple(terms), coef, cov, float(np.sqrt(rss / n)), n, n_eff, float(bic))
+
+
+def forward_select(ship, segments, eq: str, candidates, required=(), lags: int = 20) -> Fit:
+    """Forward stepwise selection: start from ``required`` terms, add the candidate that lowers the
+    BIC most, stop when none does."""
+    chosen = [t for t in candidates if t in required]
+    rest = [t for t in candidates if t not in required]
+    A_all, y, bounds = design(ship, segments, eq, list(candidates))
+    col = {t: i for i, t in enumerate(candidates)}
+
+    def fit(ts):
+        return ols(A_all[:, [col[t] for t in ts]], y, ts, bounds, lags)
+
+    best = fit(chosen) if chosen else None
+    while rest:
+        trials = [(fit(chosen + [t]), t) for t in rest]
+        cand, t = min(trials, key=lambda ft: ft[0].bic)
+        if best is not None and cand.bic >= best.bic:
+            break
+        best, chosen = cand, chosen + [t]
+        rest.remove(t)
+    return best
+
+
+def identify(ship, segments, structure: str = "mmg", select: bool = True, lags: int = 20) -> dict:
+    """Fit the hull terms of ``structure`` (a key of :data:`mmg.STRUCTURES`) to all segments.
+
+    With ``select`` the terms are chosen by forward BIC selection (constant X_0 and the linear
+    derivatives always kept). Returns {eq: Fit}."""
+    if structure not in mmg.STRUCTURES:
+        raise InputError(_WHERE, "structure", f"{structure!r}; allowed: {', '.join(mmg.STRUCTURES)}")
+    out = {}
+    for eq, terms in mmg.STRUCTURES[structure].items():
+        req = tuple(t for t in terms if t in mmg.LINEAR or t == "X_0")
+        if select:
+            out[eq] = forward_select(ship, segments, eq, terms, req, lags)
+        else:
+            A, y, bounds = design(ship, segments, eq, terms)
+            out[eq] = ols(A, y, terms, bounds, lags)
+    return out
+
+
+def coefficients(fits: dict) -> dict:
+    """Merge the per-equation fits into one {term: value} mapping."""
+    return {k: v for f in fits.values() for k, v in f.as_dict().items()}
+
+
+def cross_validate(ship, segments, structures=("mmg", "blanke"), select: bool = True,
+                   lags: int = 20) -> dict:
+    """Leave-one-maneuver-out cross-validation of the hull-force prediction.
+
+    For each structure: fit on all segments but one, predict the held-out segment's non-dimensional
+    hull forces; returns {structure: {eq: RMS prediction error}} over all held-out samples."""
+    if len(segments) < 2:
+        raise InputError(_WHERE, "segments", f"{len(segments)}; allowed: ≥ 2 maneuvers for cross-validation")
+    out = {}
+    for s in structures:
+        err = {eq: [] for eq in "XYN"}
+        for i in range(len(segments)):
+            train = [g for j, g in enumerate(segments) if j != i]
+            fits = identify(ship, train, s, select, lags)
+            for eq, ft in fits.items():
+                A, y, _ = design(ship, [segments[i]], eq, ft.terms)
+                err[eq].append(y - A @ ft.coef)
+        out[s] = {eq: float(np.sqrt(np.mean(np.concatenate(e)**2))) for eq, e in err.items()}
+    return out
