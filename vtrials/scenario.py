@@ -175,18 +175,10 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     if len(given) > 1 or (len(given) == 0 and not has_agenda):
         raise InputError(f, "initial", "give exactly one of froude_number, speed_kn, speed_mps, engine_order"
                          + (f" (got {', '.join(given)})" if given else ""))
-<<<<<<< HEAD
     env_tab = table(doc.get("environment"), f, "environment")
     cur_tab = table(env_tab.pop("current", None), f, "environment.current")
     wind_tab = table(env_tab.pop("wind", None), f, "environment.wind")
-=======
-    env_tab = dict(doc.get("environment", {}))
-    if not isinstance(env_tab, dict):
-        raise InputError(f, "environment", "expected a table")
-    cur_tab = env_tab.pop("current", {})
-    wind_tab = env_tab.pop("wind", {})
-    waves_tab = env_tab.pop("waves", {})
->>>>>>> seakeeping
+    waves_tab = table(env_tab.pop("waves", None), f, "environment.waves")
     env, _ = read_table(Environment, env_tab, f, "environment")
     if env.water_depth_m <= vessel.particulars.draught:
         raise InputError(f, "environment.water_depth_m", f"{env.water_depth_m} m does not float the ship "
@@ -200,20 +192,13 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     wind, _ = read_table(Wind, wind_tab, f, "environment.wind")
     if wind.speed_kn > 0 and vessel.windage is None:
         raise InputError(f, "environment.wind.speed_kn", f"{vessel.name} has no [windage] data for wind loads")
-<<<<<<< HEAD
-    items = table_list(doc.get("maneuver", []), f, "maneuver")
-    if not has_agenda and not items:
-=======
-    if not isinstance(waves_tab, dict):
-        raise InputError(f, "environment.waves", "expected a table")
     waves, _ = read_table(Waves, waves_tab, f, "environment.waves")
     waves.check(f)
     if (waves.hs_m > 0.0 or waves.swell_hs_m > 0.0) and not _hydro_path(vessel).is_file():
         raise InputError(f, "environment.waves", f"{vessel.name} has no hydrodynamic database "
                          f"({_hydro_path(vessel)}) for wave loads")
-    items = doc.get("maneuver", [])
-    if not has_agenda and (not isinstance(items, list) or not items):
->>>>>>> seakeeping
+    items = table_list(doc.get("maneuver", []), f, "maneuver")
+    if not has_agenda and not items:
         raise InputError(f, "maneuver", "expected at least one [[maneuver]] table (or an [agenda])")
     maneuvers = []
     names = set()
@@ -266,15 +251,9 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     agenda = None
     if has_agenda:
         from vtrials.trials.agenda import load_agenda
-<<<<<<< HEAD
         agenda = load_agenda(table(doc["agenda"], f, "agenda"), vessel, f)
     instruments = table_list(doc.get("instrument", []), f, "instrument")
-    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda)
-=======
-        agenda = load_agenda(doc["agenda"], vessel, f)
-    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, doc.get("instrument", []), agenda,
-                   waves=waves)
->>>>>>> seakeeping
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda, waves=waves)
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
     from vtrials.instruments.suite import InstrumentSet
     InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
