@@ -84,6 +84,23 @@ def test_weighted_regression():
     assert cw.beta1.std == pytest.approx(cu.beta1.std, rel=1e-10)
 
 
+def test_see_is_in_speed_units_whatever_the_weights():
+    """SEE is the plain residual RMS in m/s; the weighted variance factor is reported apart as a
+    reduced χ² (dimensionless). A weighted fit once printed Σwe²/(n−2) = 0.341 as "kn"."""
+    rng = np.random.default_rng(3)
+    x = np.linspace(5, 30, 8)
+    sig = np.full(8, 0.02)
+    e = 0.05 * rng.standard_normal(8)  # scatter 2.5× the stated σ
+    c = L.calibrate(x, 0.4 + 0.3 * x + e, std=sig, absolute_sigma=False)
+    assert c.see == pytest.approx(np.sqrt(np.sum(c.residuals ** 2) / 6), rel=1e-12)
+    assert c.scale2 == pytest.approx(np.sum((c.residuals / sig) ** 2) / 6, rel=1e-12)
+    # rescaling all σᵢ changes the χ² but neither the SEE nor the coefficient errors
+    c10 = L.calibrate(x, 0.4 + 0.3 * x + e, std=10 * sig, absolute_sigma=False)
+    assert c10.see == pytest.approx(c.see, rel=1e-12)
+    assert c10.scale2 == pytest.approx(c.scale2 / 100, rel=1e-10)
+    assert c10.beta1.std == pytest.approx(c.beta1.std, rel=1e-10)
+
+
 def test_band_coverage_monte_carlo():
     """Mean-response band covers the true line, prediction band covers a new observation, each at
     95 % ± 3 binomial standard errors over 400 realizations."""

@@ -33,8 +33,11 @@ class Calibration:
     """STW = β₀ + β₁ · reading.
 
     beta0 [m/s], beta1 [m/s per reading unit] as Estimates (dof n − 2); r2, r (correlation);
-    see: standard error of estimate σ̂ [m/s]; residuals [m/s]; xbar, sxx (weighted if weights);
-    sum_w (n when unweighted); cov: covariance of (β₀, β₁).
+    see: standard error of estimate √(Σ eᵢ² / (n − 2)) [m/s] of the plain residuals, whatever the
+    weights; scale2: the fit's variance factor Σ wᵢeᵢ² / (n − 2) — σ̂² in m²/s² when unweighted, the
+    dimensionless reduced χ² when wᵢ = 1/σᵢ² (≈ 1 when the stated σᵢ explain the scatter);
+    residuals [m/s]; xbar, sxx (weighted if weights); sum_w (n when unweighted); cov: covariance of
+    (β₀, β₁).
     """
 
     beta0: Estimate
@@ -42,6 +45,7 @@ class Calibration:
     r2: float
     r: float
     see: float
+    scale2: float
     residuals: np.ndarray
     x: np.ndarray
     y: np.ndarray
@@ -58,7 +62,7 @@ class Calibration:
         return self.beta0.value + self.beta1.value * np.asarray(reading, dtype=float)
 
     def _s2(self):
-        return 1.0 if self.absolute_sigma else self.see ** 2
+        return 1.0 if self.absolute_sigma else self.scale2
 
     def _q(self, level):
         if self.absolute_sigma:
@@ -130,7 +134,7 @@ def calibrate(log_reading, true_stw, std=None, absolute_sigma=None) -> Calibrati
     sse = float(np.dot(w, res * res))
     dof = n - 2
     s2 = sse / dof
-    see = math.sqrt(s2)
+    see = math.sqrt(float(np.dot(res, res)) / dof)
     s2_use = 1.0 if absolute_sigma else s2
     var_b1 = s2_use / sxx
     var_b0 = s2_use * (1.0 / sw + xbar * xbar / sxx)
@@ -139,7 +143,7 @@ def calibrate(log_reading, true_stw, std=None, absolute_sigma=None) -> Calibrati
     est_dof = None if absolute_sigma else dof
     return Calibration(
         beta0=Estimate(b0, math.sqrt(var_b0), est_dof), beta1=Estimate(b1, math.sqrt(var_b1), est_dof),
-        r2=r2, r=math.copysign(math.sqrt(max(r2, 0.0)), b1), see=see, residuals=res, x=x, y=y, n=n,
+        r2=r2, r=math.copysign(math.sqrt(max(r2, 0.0)), b1), see=see, scale2=s2, residuals=res, x=x, y=y, n=n,
         dof=dof, xbar=xbar, sxx=sxx, sum_w=sw, cov=np.array([[var_b0, cov01], [cov01, var_b1]]),
         absolute_sigma=bool(absolute_sigma))
 

@@ -477,7 +477,7 @@ def reduce_log_calibration(rec: Record) -> dict:
         cal = LC.calibrate(xr, yr, std=ys, absolute_sigma=False)
         xs = np.linspace(0.0, float(xr.max()) * 1.05, 50)
         lo, hi = cal.band(xs) if hasattr(cal, "band") else (None, None)
-        calibrations[name] = {"intercept": _est(cal.beta0), "slope": _est(cal.beta1), "r2": cal.r2, "see": cal.see,
+        calibrations[name] = {"intercept": _est(cal.beta0), "slope": _est(cal.beta1), "r2": cal.r2, "see": cal.see, "chi2_red": cal.scale2,
                               "n": cal.n, "dof": cal.dof, "x": xr.tolist(), "y": yr.tolist(), "y_std": ys.tolist(),
                               "groups": gs, "excluded_groups": sorted(set(groups) - set(gs)),
                               "band_x": xs.tolist(),

@@ -200,7 +200,7 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
         e = err["calibrations"].get(inst)
         L += [f"**{inst}**: STW = {_fmt(cal['intercept']['value'] / KNOT, 3)} kn (± {_fmt(cal['intercept']['std'] / KNOT, 3)}) + "
               f"{_fmt(cal['slope']['value'], 4)} (± {_fmt(cal['slope']['std'], 4)}) × reading; r² = {cal['r2']:.5f}, "
-              f"SEE = {_fmt(cal['see'] / KNOT, 3)} kn, n = {cal['n']}"
+              f"SEE = {_fmt(cal['see'] / KNOT, 3)} kn (residual RMS), reduced χ² = {_fmt(cal.get('chi2_red'), 2)}, n = {cal['n']}"
               + (f"; true: {_fmt(e['true_line']['intercept_mps'] / KNOT, 3)} kn + {_fmt(e['true_line']['slope'], 4)} × reading "
                  f"(intercept covered: {e['intercept']['covered']}, slope covered: {e['slope']['covered']})" if e else ""), ""]
     L += ["| run | group | course | V_G [kn] | STW [kn] | ± (95 %) | true STW [kn] | err [kn] | covered |",
