@@ -458,9 +458,7 @@ def _run_steps(nstep, every, step_count, krow, hook_id, wcount,
                             ecount, ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch)
         if nbad:
             return done, krow, STOP_STATUS
-        with nb.objmode(code="int64"):
-            code = _batch_step(hook_id)
-        if code != 0:
+        if _hook_step(hook_id) != 0:
             return done, krow, STOP_MUJOCO
         for i in range(wcount.shape[0]):
             for j in range(wcount.shape[1]):
@@ -474,6 +472,15 @@ STOP_STATUS, STOP_MUJOCO, STOP_WARNING = 1, 2, 3
 
 # simulators that step through _run_steps, by hook id (weak: a simulator's entry goes with it)
 _HOOKS: dict = {}
+
+
+@nb.njit(cache=True)
+def _hook_step(hook_id):
+    """:func:`_batch_step` from compiled code (object mode; in a function of its own, the switch to
+    object mode costs about half of what it does inside the loop)."""
+    with nb.objmode(code="int64"):
+        code = _batch_step(hook_id)
+    return code
 
 
 def _batch_step(hook_id: int) -> int:
