@@ -264,7 +264,7 @@ def coefficients(p, beta, pd):
     return ct, cq
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def kernel(p, s, env, ctx, aux, w):
     k = int(p[P_IDX])
     Lpp = p[P_L]
