@@ -7,7 +7,8 @@ SyncVectorEnv of the scalar env (N copies, each its own one-ship batch). Rates a
 per second (physics steps × ships) and environment steps per second (control periods × ships), and
 the simulator alone (Simulator.step of the env's batch, no env layer) to split the cost; the
 ratio to the bare batch is the acceptance figure (target ≥ 50 % at N = 256). Rounds of the three
-are interleaved and medians reported: the machine may be shared.
+are interleaved and medians reported: the machine may be shared (the 1-minute load average before
+and after is written with the results).
 
     python benchmarks/bench_envs.py [--ship patrol51] [--task CourseKeeping] [--sea wind_current]
                                     [--nthread 2] [--seconds 1] [--rounds 5] [--sync-max 64]
@@ -92,6 +93,7 @@ def main(argv=None):
     ap.add_argument("--sync-max", type=int, default=64, help="largest N run through SyncVectorEnv")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
+    load_before = os.getloadavg()[0]
     rows = []
     print(f"{a.ship} {a.task} sea={a.sea} nthread={a.nthread}")
     print(f"{'N':>5} {'vec env steps/s':>16} {'vec ship-steps/s':>17} {'bare batch':>12} {'vec/bare':>9} "
@@ -105,7 +107,8 @@ def main(argv=None):
               f"{row['sync_env_steps_per_s']:>17.0f} {row['vector_over_sync']:>9.2f}", flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps({"ship": a.ship, "task": a.task, "sea": a.sea, "nthread": a.nthread,
-                                            "rows": rows}, indent=1))
+                                            "load_average_1min": [load_before, os.getloadavg()[0]],
+                                            "cpus": os.cpu_count(), "rows": rows}, indent=1))
 
 
 if __name__ == "__main__":

@@ -51,8 +51,9 @@ NNAV = 4
 LIM_SPEED, LIM_ANGLE, LIM_RATE = 0, 1, 2
 
 # the component dispatch the step kernel calls: each compilation of the kernel (step_kernels) binds it
-# to the dispatch generated for its component types
+# to the dispatch generated for its component types; likewise the step kernel _run_steps calls
 dispatch = None
+_step_kernel = None
 
 
 @nb.njit(cache=True)
@@ -104,6 +105,79 @@ def _clip(x, lim):
     if x < -lim:
         return -lim
     return x
+
+
+@nb.njit(cache=True)
+def kinematics(q, v, t, e, steer, shaftp, R, nu1, om, nu1r, c):
+    """One ship's kinematics from its MuJoCo state (q = qpos, v = qvel, t time, e environment block):
+    fills R (body→world), ν₁ (body-frame velocity over ground), ω, ν₁ᵣ (through the water) and the
+    context entries NU_R, NU, POS, EUL, TIME, DEPTH, ROT, CUR, CUR_ACC, DELTA, DELTA_DOT, SHAFT_N;
+    returns (φ, θ, ψ, V_C north, V_C east, a_C (body, 3)) with a_C the current's rate seen from the ship.
+    """
+    qn = math.sqrt(q[3] ** 2 + q[4] ** 2 + q[5] ** 2 + q[6] ** 2)
+    quat_to_mat(q[3] / qn, q[4] / qn, q[5] / qn, q[6] / qn, R)
+    for j in range(3):
+        nu1[j] = R[j] * v[0] + R[3 + j] * v[1] + R[6 + j] * v[2]
+        om[j] = v[3 + j]
+    x = q[0]
+    y = q[1]
+    phi = math.atan2(R[7], R[8])
+    st = -R[6]
+    if st > 1.0:
+        st = 1.0
+    elif st < -1.0:
+        st = -1.0
+    theta = math.asin(st)
+    psi = math.atan2(R[3], R[0])
+    vcn, vce, acn, ace = current_at(e, x, y, t)
+    # body-frame current and its rate as seen from the moving ship
+    vcb0 = R[0] * vcn + R[3] * vce
+    vcb1 = R[1] * vcn + R[4] * vce
+    vcb2 = R[2] * vcn + R[5] * vce
+    gx = v[0]
+    gy = v[1]
+    dvn = acn + e[9] * gx + e[10] * gy
+    dve = ace + e[11] * gx + e[12] * gy
+    ac0 = -(om[1] * vcb2 - om[2] * vcb1) + R[0] * dvn + R[3] * dve
+    ac1 = -(om[2] * vcb0 - om[0] * vcb2) + R[1] * dvn + R[4] * dve
+    ac2 = -(om[0] * vcb1 - om[1] * vcb0) + R[2] * dvn + R[5] * dve
+    nu1r[0] = nu1[0] - vcb0
+    nu1r[1] = nu1[1] - vcb1
+    nu1r[2] = nu1[2] - vcb2
+    for j in range(3):
+        c[L.NU_R + j] = nu1r[j]
+        c[L.NU_R + 3 + j] = om[j]
+        c[L.NU + j] = nu1[j]
+        c[L.NU + 3 + j] = om[j]
+        c[L.POS + j] = q[j]
+    c[L.EUL] = phi
+    c[L.EUL + 1] = theta
+    c[L.EUL + 2] = psi
+    c[L.TIME] = t
+    c[L.DEPTH] = e[E_DEPTH]
+    for j in range(9):
+        c[L.ROT + j] = R[j]
+    c[L.CUR] = vcn
+    c[L.CUR + 1] = vce
+    # material (fluid-particle) acceleration of the current: ∂V/∂t + (V·∇)V
+    c[L.CUR_ACC] = acn + e[9] * vcn + e[10] * vce
+    c[L.CUR_ACC + 1] = ace + e[11] * vcn + e[12] * vce
+    for k in range(steer.shape[0]):
+        c[L.DELTA + k] = q[int(steer[k, 3])]
+        c[L.DELTA_DOT + k] = v[int(steer[k, 4])]
+    for k in range(shaftp.shape[0]):
+        c[L.SHAFT_N + int(shaftp[k, PR.S_PROP])] = v[int(shaftp[k, PR.S_DADR])] / (2.0 * math.pi)
+    return phi, theta, psi, vcn, vce, ac0, ac1, ac2
+
+
+@nb.njit(cache=True)
+def kinematics_all(qpos, qvel, time, env, steer, shaftp, ctx, scratch):
+    """:func:`kinematics` of every ship into ``ctx`` (N, NCTX), the same values a step kernel or an
+    evaluation writes there, without the forces; ``scratch`` (N, ≥ 18)."""
+    for i in range(qpos.shape[0]):
+        sc = scratch[i]
+        kinematics(qpos[i], qvel[i], time[i], env[i], steer, shaftp, sc[0:9], sc[9:12], sc[12:15], sc[15:18],
+                   ctx[i])
 
 
 def record_width(n_rudders: int, n_shafts: int, n_components: int) -> int:
@@ -158,74 +232,23 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
         c = ctx[i]
         a = aux[i]
         t = time[i]
-        qn = math.sqrt(qpos[i, 3] ** 2 + qpos[i, 4] ** 2 + qpos[i, 5] ** 2 + qpos[i, 6] ** 2)
-        quat_to_mat(qpos[i, 3] / qn, qpos[i, 4] / qn, qpos[i, 5] / qn, qpos[i, 6] / qn, R)
-        for j in range(3):
-            nu1[j] = R[j] * qvel[i, 0] + R[3 + j] * qvel[i, 1] + R[6 + j] * qvel[i, 2]
-            om[j] = qvel[i, 3 + j]
-        x = qpos[i, 0]
-        y = qpos[i, 1]
-        phi = math.atan2(R[7], R[8])
-        st = -R[6]
-        if st > 1.0:
-            st = 1.0
-        elif st < -1.0:
-            st = -1.0
-        theta = math.asin(st)
-        psi = math.atan2(R[3], R[0])
+        e = env[i]
+        phi, theta, psi, vcn, vce, ac0, ac1, ac2 = kinematics(qpos[i], qvel[i], t, e, steer, shaftp, R, nu1, om,
+                                                              nu1r, c)
         psi_u = nav[i, NV_PSI_U] + H.wrap(psi - nav[i, NV_PSI_U])
         nav[i, NV_PSI_U] = psi_u
-        e = env[i]
-        vcn, vce, acn, ace = current_at(e, x, y, t)
-        # body-frame current and its rate as seen from the moving ship
-        vcb0 = R[0] * vcn + R[3] * vce
-        vcb1 = R[1] * vcn + R[4] * vce
-        vcb2 = R[2] * vcn + R[5] * vce
-        gx = qvel[i, 0]
-        gy = qvel[i, 1]
-        dvn = acn + e[9] * gx + e[10] * gy
-        dve = ace + e[11] * gx + e[12] * gy
-        ac0 = -(om[1] * vcb2 - om[2] * vcb1) + R[0] * dvn + R[3] * dve
-        ac1 = -(om[2] * vcb0 - om[0] * vcb2) + R[1] * dvn + R[4] * dve
-        ac2 = -(om[0] * vcb1 - om[1] * vcb0) + R[2] * dvn + R[5] * dve
-        nu1r[0] = nu1[0] - vcb0
-        nu1r[1] = nu1[1] - vcb1
-        nu1r[2] = nu1[2] - vcb2
-        # --- context
-        for j in range(3):
-            c[L.NU_R + j] = nu1r[j]
-            c[L.NU_R + 3 + j] = om[j]
-            c[L.NU + j] = nu1[j]
-            c[L.NU + 3 + j] = om[j]
-            c[L.POS + j] = qpos[i, j]
-        c[L.EUL] = phi
-        c[L.EUL + 1] = theta
-        c[L.EUL + 2] = psi
-        c[L.TIME] = t
         c[L.DT] = dt
-        c[L.DEPTH] = e[E_DEPTH]
-        for j in range(9):
-            c[L.ROT + j] = R[j]
-        c[L.CUR] = vcn
-        c[L.CUR + 1] = vce
-        # material (fluid-particle) acceleration of the current: ∂V/∂t + (V·∇)V
-        c[L.CUR_ACC] = acn + e[9] * vcn + e[10] * vce
-        c[L.CUR_ACC + 1] = ace + e[11] * vcn + e[12] * vce
         # --- helm: one order for all rudders
         if nr > 0:
             order = H.helm_step(i, t, psi_u, om[2], dt, phases, hs, events, ecount, rud_cmd[i, 0])
             for k in range(nr):
                 rud_cmd[i, k] = order
-        for k in range(nr):
-            c[L.DELTA + k] = qpos[i, int(steer[k, 3])]
-            c[L.DELTA_DOT + k] = qvel[i, int(steer[k, 4])]
         # --- machinery before the forces: pitch actuators, set-point ramps, engine torque
         for k in range(ns):
             sp = shaftp[k]
             ms = mach[i, k]
-            n = qvel[i, int(sp[PR.S_DADR])] / (2.0 * math.pi)
             kp = int(sp[PR.S_PROP])
-            c[L.SHAFT_N + kp] = n
+            n = c[L.SHAFT_N + kp]
             if sp[PR.S_CP] > 0.0:
                 pc = pitch_cmd[i, k]
                 if pc > sp[PR.S_PITCH_MAX]:
@@ -408,6 +431,70 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
     return nbad
 
 
+def _run_steps(nstep, every, step_count, krow, hook_id, wcount,
+               dt, qpos, qvel, time, qfrc,
+               comp_kind, comp_off, comp_par, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer, shaftp, env,
+               rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events, ecount,
+               ctx, aux, comp_w, nudot, limits, status, rec, scratch):
+    """Up to ``nstep`` whole time steps in one call: the step kernel, then MuJoCo's step of the batch
+    (through the simulator's hook, in object mode), then MuJoCo's warning counters ``wcount``.
+
+    The same work and order as one kernel call and one ``Batch.step`` per step from Python, without
+    the per-step cost of handing ~40 arrays to the kernel. A truth row is written (into ``rec``, from
+    row ``krow`` on) at every step whose count ``step_count + k`` is a multiple of ``every`` (never
+    when ``every`` is 0; the caller leaves room). Returns (steps completed, next row, code): code 0
+    all done, STOP_STATUS a ship's status is not OK (that step's row written, MuJoCo not stepped),
+    STOP_MUJOCO the batch raised (the hook keeps the exception), STOP_WARNING a warning counter rose.
+    """
+    done = 0
+    for k in range(nstep):
+        krec = -1
+        if every > 0 and (step_count + k) % every == 0:
+            krec = krow
+            krow += 1
+        nbad = _step_kernel(dt, qpos, qvel, time, qfrc,
+                            comp_kind, comp_off, comp_par, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer,
+                            shaftp, env, rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events,
+                            ecount, ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch)
+        if nbad:
+            return done, krow, STOP_STATUS
+        if _hook_step(hook_id) != 0:
+            return done, krow, STOP_MUJOCO
+        for i in range(wcount.shape[0]):
+            for j in range(wcount.shape[1]):
+                if wcount[i, j] != 0:
+                    return done, krow, STOP_WARNING
+        done += 1
+    return done, krow, 0
+
+
+STOP_STATUS, STOP_MUJOCO, STOP_WARNING = 1, 2, 3
+
+# simulators that step through _run_steps, by hook id (weak: a simulator's entry goes with it)
+_HOOKS: dict = {}
+
+
+@nb.njit(cache=True)
+def _hook_step(hook_id):
+    """:func:`_batch_step` from compiled code (object mode; in a function of its own, the switch to
+    object mode costs about half of what it does inside the loop)."""
+    with nb.objmode(code="int64"):
+        code = _batch_step(hook_id)
+    return code
+
+
+def _batch_step(hook_id: int) -> int:
+    """One ``Batch.step`` of the simulator registered under ``hook_id`` (called from _run_steps in
+    object mode); 0, or 1 when the batch raised (the exception is kept on the simulator)."""
+    sim = _HOOKS[hook_id]()
+    try:
+        sim.batch.step()
+    except BaseException as exc:  # handed back to the simulator, which raises it after the call
+        sim._hook_error = exc
+        return 1
+    return 0
+
+
 def _twin(f, name, globals_):
     """A copy of function f under another name, resolving its globals in ``globals_``: numba's cache
     is keyed by the function's name, so each compilation of one source gets its own name."""
@@ -435,3 +522,20 @@ def step_kernels(component_types: list) -> tuple:
         threaded = nb.njit(cache=True, parallel=True)(_twin(_step_forces, f"_step_forces_parallel_{tag}", g))
         _KERNELS[tag] = (serial, threaded)
     return _KERNELS[tag]
+
+
+_LOOPS: dict[str, tuple] = {}
+
+
+def step_loops(component_types: list) -> tuple:
+    """(serial, threaded) multi-step loops (:func:`_run_steps`) around :func:`step_kernels`' kernels."""
+    serial, threaded = step_kernels(component_types)
+    _, tag = registry.dispatcher(list(component_types))
+    if tag not in _LOOPS:
+        loops = []
+        for kern, name in ((serial, f"_run_steps_{tag}"), (threaded, f"_run_steps_parallel_{tag}")):
+            g = dict(_run_steps.__globals__)
+            g["_step_kernel"] = kern
+            loops.append(nb.njit(cache=True)(_twin(_run_steps, name, g)))
+        _LOOPS[tag] = tuple(loops)
+    return _LOOPS[tag]

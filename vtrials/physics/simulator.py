@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import itertools
 import math
+import weakref
 
 import mujoco
 import numpy as np
@@ -33,6 +35,7 @@ from vtrials.physics.vessel import Vessel
 
 
 PARALLEL_FROM = 8  # batches at least this large use the threaded kernel (when nthread > 1)
+_HOOK_IDS = itertools.count()
 
 
 @dataclasses.dataclass
@@ -174,7 +177,14 @@ class Simulator:
         self.scratch = np.zeros((self.n, 64))
         # many ships: the same per-ship kernel spread over threads (bit-identical results)
         serial, threaded = DY.step_kernels(self.comp_types)
-        self._kernel = threaded if (self.n >= PARALLEL_FROM and nthread > 1) else serial
+        threads = self.n >= PARALLEL_FROM and nthread > 1
+        self._kernel = threaded if threads else serial
+        # whole runs of steps in one compiled call (kernel + the batch's step through a hook)
+        self._loop = DY.step_loops(self.comp_types)[1 if threads else 0]
+        self._hook_id = next(_HOOK_IDS)
+        self._hook_error = None
+        DY._HOOKS[self._hook_id] = weakref.ref(self)
+        weakref.finalize(self, DY._HOOKS.pop, self._hook_id, None)
         Lpp = vessel.length
         if limits is None:
             # runaway limits: Fn 2 through the water, 70° heel or trim, 3 rad/s
@@ -188,6 +198,7 @@ class Simulator:
         self._krow = 0
         self._step_count = 0
         self._no_rec = np.zeros((1, self.n, self.rec_width))
+        self._kin = None
 
     # ------------------------------------------------------------------ state
     def set_state(self, ship: int, s: ShipState) -> None:
@@ -258,6 +269,18 @@ class Simulator:
         st = self.comp_st.copy()
         self._call(nav=nav, mach=mach, hs=hs, events=ev, ecount=ec, rud_cmd=rc, comp_st=st, krec=-1)
         return self.nudot.copy()
+
+    def kinematics(self) -> np.ndarray:
+        """The kinematic part of the context at the current states, (N, NCTX): velocities (over
+        ground and through the water), position, Euler angles, time, rotation matrix, current,
+        rudder angles and rates, shaft speeds — the values :meth:`evaluate` puts in ``ctx``, without
+        computing forces (no side effects; the other entries are zero)."""
+        if self._kin is None:
+            self._kin = np.zeros((self.n, L.NCTX))
+            self._kin_scratch = np.zeros((self.n, 18))
+        DY.kinematics_all(self.qpos, self.qvel, self.time, self.env, self.steer, self.shaftp, self._kin,
+                          self._kin_scratch)
+        return self._kin
 
     def _call(self, nav=None, mach=None, hs=None, events=None, ecount=None, rud_cmd=None, comp_st=None, krec=-1,
               rec=None):
@@ -366,27 +389,44 @@ class Simulator:
 
     # ------------------------------------------------------------------ stepping
     def step(self, nstep: int = 1) -> None:
-        """Advance every ship by ``nstep`` time steps."""
+        """Advance every ship by ``nstep`` time steps.
+
+        Runs of steps go to one compiled call (:func:`vtrials.physics.dynamics._run_steps`: the step
+        kernel and the batch's step, per step, as a Python loop over both would), each run as long as
+        the truth chunk has room for its rows.
+        """
         every = self.record_every
-        for _ in range(nstep):
-            krec = -1
+        left = int(nstep)
+        while left > 0:
+            m = left
             rec = self._no_rec
-            if every and self._step_count % every == 0:
-                if self._chunk is None or self._krow >= self._chunk.shape[0]:
-                    self._new_chunk()
-                krec = self._krow
-                rec = self._chunk
-                self._krow += 1
-            nbad = self._call(krec=krec, rec=rec)
-            if nbad:
+            if every:
+                first = (-self._step_count) % every  # the run's first recorded step
+                if first < left:
+                    if self._chunk is None or self._krow >= self._chunk.shape[0]:
+                        self._new_chunk()
+                    rec = self._chunk
+                    m = min(left, first + (rec.shape[0] - self._krow) * every)
+            done, krow, code = self._loop(
+                m, every, self._step_count, self._krow, self._hook_id, self._wcount,
+                self.dt, self.qpos, self.qvel, self.time, self.qfrc,
+                self.comp_kind, self.comp_off, self.comp_par, self.comp_soff, self.comp_st, self.minv, self.mrb,
+                self.ma, self.coriolis_mode, self.rb, self.steer, self.shaftp, self.env,
+                self.rud_cmd, self.shaft_cmd, self.pitch_cmd, self.shaft_mode, self.mach, self.nav,
+                self.phases, self.hs, self.events, self.ecount,
+                self.ctx, self.aux, self.comp_w, self.nudot, self.limits, self.status, rec, self.scratch)
+            self._step_count += done
+            self._krow = krow
+            left -= done
+            if code == DY.STOP_STATUS:
                 self._raise_status()
-            try:
-                self.batch.step()
-            except mjbatch.SimulationError as exc:
-                self._raise_mujoco(int(exc.ids[0]), str(exc))
-            if self._wcount.any():
+            elif code == DY.STOP_MUJOCO:
+                exc, self._hook_error = self._hook_error, None
+                if isinstance(exc, mjbatch.SimulationError):
+                    self._raise_mujoco(int(exc.ids[0]), str(exc))
+                raise exc
+            elif code == DY.STOP_WARNING:
                 self._raise_mujoco(int(np.flatnonzero(self._wcount.any(axis=1))[0]), None)
-            self._step_count += 1
 
     def _raise_mujoco(self, i: int, text: str | None):
         """A MuJoCo warning (its warning counters rose) or error in ship i: stop with the time and state."""

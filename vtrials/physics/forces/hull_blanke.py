@@ -108,7 +108,7 @@ def resistance(p, u):
     return R
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, inline="always")
 def kernel(p, s, env, ctx, aux, w):
     u = ctx[L.NU_R + 0]
     v = ctx[L.NU_R + 1]

@@ -123,7 +123,7 @@ def dispatcher(types: list[ComponentType]):
              "import numba as nb"]
     for k, t in enumerate(types):
         lines.append(f"from {t.module} import {t.attr} as _k{k}")
-    lines += ["", "", "@nb.njit(cache=True)", "def dispatch(kind, p, s, env, ctx, aux, w):"]
+    lines += ["", "", "@nb.njit(cache=True, inline=\"always\")", "def dispatch(kind, p, s, env, ctx, aux, w):"]
     for k, t in enumerate(types):
         lines.append(f"    {'if' if k == 0 else 'elif'} kind == {k}:  # {t.name}")
         lines.append(f"        _k{k}(p, s, env, ctx, aux, w)")

@@ -22,6 +22,7 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.physics.forces import context as L
+from vtrials.physics.forces._wavetable import heading_fold, lerp
 from vtrials.physics.forces.registry import register
 
 
@@ -61,21 +62,12 @@ def drift_kernel(p, s, env, ctx, aux, w):
         a2 = p[q]
         cm = p[q + 1]
         sm = p[q + 2]
-        b = math.atan2(sm * cp - cm * sp, cm * cp + sm * sp)     # β = μ − ψ in (−π, π]
-        sgn = 1.0
-        if b < 0.0:
-            b = -b
-            sgn = -1.0
-        f = b / dh
-        i0 = int(f)
-        if i0 >= nbeta - 1:
-            i0 = nbeta - 2
-        fr = f - i0
+        i0, fr, sgn = heading_fold(cm, sm, cp, sp, dh, nbeta)     # β = μ − ψ, folded
         t0 = q + 3 + 3 * i0
         t1 = t0 + 3
-        fx += a2 * ((1.0 - fr) * p[t0] + fr * p[t1])
-        fy += sgn * a2 * ((1.0 - fr) * p[t0 + 1] + fr * p[t1 + 1])
-        mz += sgn * a2 * ((1.0 - fr) * p[t0 + 2] + fr * p[t1 + 2])
+        fx += a2 * lerp(p, t0, t1, fr)
+        fy += sgn * a2 * lerp(p, t0 + 1, t1 + 1, fr)
+        mz += sgn * a2 * lerp(p, t0 + 2, t1 + 2, fr)
     fn = cp * fx - sp * fy
     fe = sp * fx + cp * fy
     for k in range(3):

@@ -27,6 +27,7 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.physics.forces import context as L
+from vtrials.physics.forces._wavetable import heading_fold, lerp
 from vtrials.physics.forces.registry import register
 
 HEAD = 8
@@ -57,6 +58,14 @@ def pack(db, components: np.ndarray, dofs=(0, 1, 2, 3, 4, 5)) -> np.ndarray:
     return np.concatenate(out).astype(np.float64)
 
 
+@nb.njit(cache=True, inline="always")
+def _dof(p, r0, r1, di, fr, ct, st):
+    """Re{X e^{iθ}} a for one DOF: X interpolated between heading rows r0, r1 (Im X di further)."""
+    xr = lerp(p, r0, r1, fr)
+    xi = lerp(p, r0 + di, r1 + di, fr)
+    return xr * ct - xi * st
+
+
 @nb.njit(cache=True, fastmath=False)
 def excitation_kernel(p, s, env, ctx, aux, w):
     n = int(p[0])
@@ -71,8 +80,8 @@ def excitation_kernel(p, s, env, ctx, aux, w):
     psi = ctx[L.EUL + 2]
     cp = math.cos(psi)
     sp = math.sin(psi)
-    for j in range(6):
-        w[j] = 0.0
+    # the six sums in registers (w is written once): the same additions in the same order
+    f0 = f1 = f2 = f3 = f4 = f5 = 0.0
     for c in range(n):
         q = base + c * stride
         a = p[q]
@@ -83,26 +92,27 @@ def excitation_kernel(p, s, env, ctx, aux, w):
         th = om * t - k * (x * cm + y * sm) + p[q + 5]
         ct = a * math.cos(th)
         st = a * math.sin(th)
-        # β = μ − ψ in (−π, π] from cos/sin of the difference (one atan2, no further trig)
-        b = math.atan2(sm * cp - cm * sp, cm * cp + sm * sp)
-        sgn = 1.0
-        if b < 0.0:
-            b = -b
-            sgn = -1.0
-        f = b / dh
-        i0 = int(f)
-        if i0 >= nbeta - 1:
-            i0 = nbeta - 2
-        fr = f - i0
-        re0 = q + 6
-        im0 = re0 + 6 * nbeta
-        for d in range(6):
-            xr = (1.0 - fr) * p[re0 + 6 * i0 + d] + fr * p[re0 + 6 * (i0 + 1) + d]
-            xi = (1.0 - fr) * p[im0 + 6 * i0 + d] + fr * p[im0 + 6 * (i0 + 1) + d]
-            m = 1.0
-            if sgn < 0.0 and (d == 1 or d == 3 or d == 5):
-                m = -1.0
-            w[d] += m * (xr * ct - xi * st)
+        i0, fr, sgn = heading_fold(cm, sm, cp, sp, dh, nbeta)   # β = μ − ψ, folded
+        r0 = q + 6 + 6 * i0      # Re X at heading row i0; row i0 + 1 is 6 further; Im X is 6 nβ further
+        r1 = r0 + 6
+        di = 6 * nbeta
+        f0 += _dof(p, r0, r1, di, fr, ct, st)
+        f2 += _dof(p, r0 + 2, r1 + 2, di, fr, ct, st)
+        f4 += _dof(p, r0 + 4, r1 + 4, di, fr, ct, st)
+        if sgn < 0.0:   # mirror image: sway, roll and yaw change sign
+            f1 += -1.0 * _dof(p, r0 + 1, r1 + 1, di, fr, ct, st)
+            f3 += -1.0 * _dof(p, r0 + 3, r1 + 3, di, fr, ct, st)
+            f5 += -1.0 * _dof(p, r0 + 5, r1 + 5, di, fr, ct, st)
+        else:
+            f1 += 1.0 * _dof(p, r0 + 1, r1 + 1, di, fr, ct, st)
+            f3 += 1.0 * _dof(p, r0 + 3, r1 + 3, di, fr, ct, st)
+            f5 += 1.0 * _dof(p, r0 + 5, r1 + 5, di, fr, ct, st)
+    w[0] = f0
+    w[1] = f1
+    w[2] = f2
+    w[3] = f3
+    w[4] = f4
+    w[5] = f5
     for d in range(6):
         w[d] *= p[2 + d]
     # the sums are in the seakeeping frame (x along the heading, horizontal; z down): to body axes,

@@ -1,0 +1,37 @@
+"""Heading tables of the wave-force components: a wave component's heading relative to the ship,
+folded onto the database's equally spaced headings 0…π, and linear interpolation between rows.
+
+A component travelling towards μ (from north, clockwise) meets a ship heading ψ at β = μ − ψ in
+(−π, π]; the database holds 0 ≤ β ≤ π and the mirror image gives β < 0 (sway, roll and yaw change
+sign: the database convention of :mod:`vtrials.physics.seakeeping.database`). Used by
+:mod:`vtrials.physics.forces.wave_excitation` and :mod:`vtrials.physics.forces.wave_drift`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+
+
+@nb.njit(cache=True, inline="always")
+def heading_fold(cm, sm, cp, sp, dh, nbeta):
+    """(i0, fr, sgn): β = μ − ψ from cos/sin of μ (cm, sm) and of ψ (cp, sp) — one atan2, no further
+    trigonometry — folded to |β| ∈ [0, π] (sgn −1 when β < 0), and its place between rows i0 and
+    i0 + 1 (fraction fr) of a table of nbeta headings dh apart starting at 0."""
+    b = math.atan2(sm * cp - cm * sp, cm * cp + sm * sp)
+    sgn = 1.0
+    if b < 0.0:
+        b = -b
+        sgn = -1.0
+    f = b / dh
+    i0 = int(f)
+    if i0 >= nbeta - 1:
+        i0 = nbeta - 2
+    return i0, f - i0, sgn
+
+
+@nb.njit(cache=True, inline="always")
+def lerp(p, k0, k1, fr):
+    """(1 − fr) p[k0] + fr p[k1]."""
+    return (1.0 - fr) * p[k0] + fr * p[k1]
