@@ -29,7 +29,10 @@ without exceeding design operating limits"). Three parts:
   the shaft does not run at the astern r/min while the blades pass through zero;
 * load-dependent pitch rate: while the pitch moves away from zero (loading the engine), its rate is
   scaled by clip((1 − λ)/(1 − λ_lim), 0, 1), λ = Q_engine/Q_avail the engine's load on its torque/power
-  limit and λ_lim = ``load_limit``; moves toward zero (unloading) keep the full rate.
+  limit at the larger of the actual and the set-point shaft speed (a load the engine could carry
+  only by losing r/min counts as an overload) and λ_lim = ``load_limit``; above λ = 1 the factor
+  turns negative and the pitch is taken back toward zero (at most at its rate) until the engine
+  carries the load at its set-point r/min. Moves toward zero (unloading) keep the full rate.
 """
 
 from __future__ import annotations
@@ -172,16 +175,26 @@ def machinery_step(sp, ms, n, n_cmd, p_cmd, mode, dt):
             pc = sp[S_PITCH_MIN]
         p = ms[M_PITCH]
         rate = sp[S_PITCH_RATE]
+        back = 0.0
         if lc:
             if pc * p < 0.0:
                 ms[M_REV] = 1.0           # ordered to the other side of zero: a reversal
             if (pc - p) * p >= 0.0 and pc != p:
                 # moving away from zero: limited by the engine's load on its torque/power limit
-                lam = ms[M_TORQUE] / available_torque(sp, n)
+                lam = ms[M_TORQUE] / available_torque(sp, max(abs(n), abs(ms[M_SETPOINT])))
                 f = (1.0 - lam) / (1.0 - sp[S_LOADLIM])
                 if f < 1.0:
-                    rate *= f if f > 0.0 else 0.0
-        ms[M_PITCH] = p + _clip(pc - p, rate * dt)
+                    if f >= 0.0:
+                        rate *= f
+                    else:
+                        # overloaded: the pitch is taken back toward zero, at most at its rate
+                        back = min(-f, 1.0) * rate * dt
+                        if back > abs(p):
+                            back = abs(p)
+        if back > 0.0:
+            ms[M_PITCH] = p - back if p > 0.0 else p + back
+        else:
+            ms[M_PITCH] = p + _clip(pc - p, rate * dt)
         if lc and ms[M_PITCH] == pc:
             ms[M_REV] = 0.0               # the pitch has reached its order
     else:
