@@ -92,6 +92,12 @@ def test_crash_astern_reversal_follows_the_load_controller(patrol):
     assert r["p"][kend] == pb
     assert r["t"][kend] == pytest.approx(1.0 + (p0 - pb) / sp[PR.S_PITCH_RATE], abs=2 * DT)
     assert 60 * r["n"][-1] == pytest.approx(60 * nb, abs=1.0)
+    # the plant before load control (issue 17) fails the zero-pitch check: its set-point ramps straight
+    # to the Back Emergency r/min, so the blades pass zero pitch near 500 r/min
+    sp_off = sp.copy()
+    sp_off[PR.S_LC] = 0.0
+    old = _run(sp_off, n0, p0, [(1.0, nb, pb)], 30.0)
+    assert 60 * old["n"][int(np.flatnonzero(old["p"] <= 0.0)[0])] > 450.0
 
 
 def test_load_limiter_holds_the_pitch_at_the_engine_limit(patrol):
