@@ -296,19 +296,87 @@ def test_patrol51_note_table_matches_the_code():
     np.testing.assert_allclose(t["R_T_holtrop"] / 1e3, holtrop_kn, atol=0.006)
 
 
-def test_patrol51_blended_curve_and_model_file():
-    """The model file's table is the blended curve: the BC93-calibrated factor up to 8 m/s, 1.3 × Holtrop
-    from 30 kn, monotone in between."""
-    from vtrials.physics.resistance import patrol51_blended_resistance, patrol51_resistance_table
+def test_hermite_bridge_is_c1_and_keeps_the_end_values():
+    """The C¹ bridge of R_W between Fn 0.40 and 0.55 meets both [H84] formulas with their values AND
+    slopes (the linear bridge has slope jumps there), and leaves R_W outside the bridge unchanged."""
+    h = patrol51_hullform()
+    lin = lambda f: wave_resistance(h, np.asarray(f, float))
+    her = lambda f: wave_resistance(h, np.asarray(f, float), bridge="hermite")
+    out = np.array([0.2, 0.3, 0.39, 0.56, 0.7])
+    np.testing.assert_array_equal(her(out), lin(out))
+    e = 1e-5
+    for fb in (0.40, 0.55):
+        # one-sided slopes: the formula's outside, the bridge's inside
+        left = (her([fb])[0] - her([fb - e])[0]) / e
+        right = (her([fb + e])[0] - her([fb])[0]) / e
+        assert right == pytest.approx(left, rel=2e-3), fb
+        l_lin = (lin([fb])[0] - lin([fb - e])[0]) / e
+        r_lin = (lin([fb + e])[0] - lin([fb])[0]) / e
+        assert abs(r_lin / l_lin - 1.0) > 0.1, fb   # the linear bridge does have a kink here
+    with pytest.raises(ValueError, match="bridge"):
+        wave_resistance(h, np.array([0.45]), bridge="spline")
+
+
+def _local_exponent(V, R):
+    return np.gradient(np.log(R), np.log(V))
+
+
+def test_patrol51_curve_has_no_kinks_and_plausible_exponents():
+    """Issue 17: the old blend had R ∝ V^2.5 at 8-10 m/s and V^0.44 at 23-30 kn, with steps in
+    d ln R/d ln V at 8 m/s and 30 kn. The model curve's local exponent must be continuous (no step
+    larger than 0.02 between neighbours 0.005 m/s apart, i.e. no kink: a kink shows as a step of
+    the size of its slope jump, 0.2-0.7 in the old curve) and within bounds argued from the physics:
+    - below the hump (V < 9.5 m/s, Fn < 0.42): 1.5 ≤ e ≤ 4.0. Friction alone gives 1.86-1.90
+      (ITTC-57); Holtrop's transom term lowers the hull's own exponent to 1.83 at Fn 0.1-0.2, the
+      level correction V^b (b = -0.26) by at most |b| more; the wave hump raises it to 3.92 in
+      Holtrop's own curve ([H84] low-speed R_W formula, this hull) just below Fn 0.40;
+    - above the hump: 1.0 ≤ e ≤ 4.0 (Holtrop's post-hump exponent 1.15-1.2 at Fn 0.6-0.7).
+    Measured: 1.57-3.81 below, 1.12-2.91 above; largest step 0.011 on this grid (old curve: 0.63).
+    """
+    from vtrials.physics.resistance import patrol51_resistance
+    V = np.arange(0.5, 16.0 + 1e-9, 0.005)
+    e = _local_exponent(V, patrol51_resistance(V)["R_T"])
+    assert np.max(np.abs(np.diff(e))) < 0.02
+    below = V < 9.5
+    assert 1.5 <= e[below].min() and e[below].max() <= 4.0, (e[below].min(), e[below].max())
+    assert 1.0 <= e[~below].min() and e[~below].max() <= 4.0, (e[~below].min(), e[~below].max())
+    # the curve the model used before (Holtrop x 1.979 up to 8 m/s, tapering linearly to 1.3 at 30 kn)
+    # fails the same check: the test would have caught it
+    t = patrol51_resistance_table(V)
+    w = np.clip((V - 8.0) / (30.0 * KNOT - 8.0), 0.0, 1.0)
+    eo = _local_exponent(V, (t["factor"] + (1.3 - t["factor"]) * w) * t["R_T_holtrop"])
+    assert np.max(np.abs(np.diff(eo))) > 0.2 or eo[~below].min() < 1.0
+
+
+def test_patrol51_curve_is_consistent_with_its_sources():
+    """R(2 m/s) = BC93's 1960 V² (the low-speed anchor) and the Froude-scaled Asheville diesel point
+    (the other anchor) exactly; then, not fitted: 30 kn inside resistance.md's 215-355 kN band; BC93's
+    law within 15 % from 1.5 to 2.5 m/s; monotone; the Asheville point's R/W band 0.030-0.035."""
+    from vtrials.physics.resistance import asheville_diesel_point, patrol51_resistance
+    A = asheville_diesel_point()
+    assert A["R_over_W"] == pytest.approx((0.0299, 0.0353), abs=2e-4)
+    assert A["speed_mps"] == pytest.approx(8.81, abs=0.01)
+    r = patrol51_resistance(np.array([2.0, A["speed_mps"], 16.0 * KNOT, 30.0 * KNOT]))["R_T"]
+    assert r[0] == pytest.approx(1960.0 * 4.0, rel=1e-9)
+    assert r[1] == pytest.approx(A["R"], rel=1e-9)
+    assert 215e3 <= r[3] <= 355e3
+    # at 16 kn: inside the Asheville band carried down from Fn∇ 1.056 with the curve's own shape
+    # (the 71-84 kN of resistance.md belong to the 244-t Asheville; per unit weight they are the band)
+    assert A["R_band"][0] * r[2] / r[1] <= r[2] <= A["R_band"][1]
+    V = np.linspace(1.5, 2.5, 21)
+    R = patrol51_resistance(V)["R_T"]
+    np.testing.assert_allclose(R, 1960.0 * V ** 2, rtol=0.15)
+    V = np.linspace(0.0, 16.0, 641)
+    assert np.all(np.diff(patrol51_resistance(V)["R_T"]) > 0)
+
+
+def test_patrol51_model_file_holds_the_curve():
+    from vtrials.physics.resistance import patrol51_resistance
     from vtrials.physics.vessel import load_vessel
-    V = np.arange(0.0, 16.5, 0.25)
-    b = patrol51_blended_resistance(V)
-    c = patrol51_resistance_table(V)
-    low = V <= 8.0
-    np.testing.assert_allclose(b["R_T"][low], c["R_T"][low], rtol=1e-12)
-    high = V >= 30.0 * 1852 / 3600
-    np.testing.assert_allclose(b["R_T"][high], 1.3 * c["R_T_holtrop"][high], rtol=1e-12)
-    assert np.all(np.diff(b["R_T"]) > 0)
     v = load_vessel("patrol51")
     sp = np.array(v.resistance.speeds)
-    np.testing.assert_allclose(np.array(v.resistance.values), patrol51_blended_resistance(sp)["R_T"], rtol=5e-4)
+    assert sp[0] == 0.0 and sp[-1] == 16.0 and np.allclose(np.diff(sp), 0.25)
+    np.testing.assert_allclose(np.array(v.resistance.values)[1:], patrol51_resistance(sp)["R_T"][1:], rtol=5e-4)
+    # the tabulated curve, interpolated linearly by the hull, stays within 1 % of the curve from 1 m/s
+    V = np.linspace(1.0, 16.0, 500)
+    np.testing.assert_allclose(np.interp(V, sp, v.resistance.values), patrol51_resistance(V)["R_T"], rtol=0.01)

@@ -249,28 +249,8 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
             ms = mach[i, k]
             kp = int(sp[PR.S_PROP])
             n = c[L.SHAFT_N + kp]
-            if sp[PR.S_CP] > 0.0:
-                pc = pitch_cmd[i, k]
-                if pc > sp[PR.S_PITCH_MAX]:
-                    pc = sp[PR.S_PITCH_MAX]
-                elif pc < sp[PR.S_PITCH_MIN]:
-                    pc = sp[PR.S_PITCH_MIN]
-                ms[PR.M_PITCH] += _clip(pc - ms[PR.M_PITCH], sp[PR.S_PITCH_RATE] * dt)
-            else:
-                ms[PR.M_PITCH] = sp[PR.S_PITCH_DESIGN]
+            PR.machinery_step(sp, ms, n, shaft_cmd[i, k], pitch_cmd[i, k], int(shaft_mode[i, k]), dt)
             c[L.PITCH + kp] = ms[PR.M_PITCH]
-            ms[PR.M_SETPOINT] += _clip(shaft_cmd[i, k] - ms[PR.M_SETPOINT], sp[PR.S_NRATE] * dt)
-            mode = int(shaft_mode[i, k])
-            if mode == PR.GOVERNED:
-                q_t, dint, qmax = PR.engine_torque(sp, n, ms[PR.M_SETPOINT], ms[PR.M_INTEG])
-                qe = ms[PR.M_TORQUE] + _clip(q_t - ms[PR.M_TORQUE], sp[PR.S_TRATE] * dt)
-                qe = _clip(qe, qmax)
-                ms[PR.M_TORQUE] = qe
-                # governor integrator, clamped to the torque available (anti-windup)
-                ms[PR.M_INTEG] = _clip(ms[PR.M_INTEG] + dt * dint, qmax)
-            else:
-                ms[PR.M_TORQUE] = 0.0
-                ms[PR.M_INTEG] = 0.0
             c[L.Q_ENGINE + k] = ms[PR.M_TORQUE]
         # --- force components
         for j in range(6):
