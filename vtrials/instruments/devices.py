@@ -433,9 +433,9 @@ class EMLog(Device):
         self.k_heel = float(self.spec.get("heel_sensitivity_per_deg", 0.0)) / DEG
 
     def reset(self, rng):
-        r1, r2 = rng.spawn(2)
+        self.chain.reset(rng)    # first, so that the error parts draw as they did before the misalignment existed
+        (r1,) = rng.spawn(1)
         self.eps = float(r1.standard_normal()) * float(self.spec.get("misalignment_deg", 0.0)) * DEG
-        self.chain.reset(r2)
 
     def measurand(self, kin, cols):
         v = kin.velocity_body(through_water=True)
@@ -487,15 +487,19 @@ class Heading(Device):
     drawn from ``corrector_latitude_error_deg``; the corrector removes arcsin(V_c cos ψ/(R_E Ω cos φ_c)),
     and the loop is Schuler-tuned at φ_c (its latitude setting), so a mis-set latitude also leaves a
     ballistic transient (damping ratio ``damping_ratio``). The site latitude is the scenario's
-    ``[site] latitude_deg``. The team knows the corrector settings (they are on the dial: meta)."""
+    ``[site] latitude_deg``. The team knows the corrector settings (they are on the dial: meta).
+    ``north_seeking = false`` describes a heading reference that does not seek north by gravity and
+    earth rate (a free-running model's heading gyro, a fibre-optic AHRS slaved to GNSS): no speed error
+    and no ballistic deflection."""
 
     kind = "heading"
-    extra_keys = {"corrector_speed_kn", "corrector_latitude_error_deg", "damping_ratio"}
+    extra_keys = {"corrector_speed_kn", "corrector_latitude_error_deg", "damping_ratio", "north_seeking"}
     channels = {"heading": ("rad", "gyrocompass heading (0..2π, clockwise from north)")}
 
     def build(self):
         super().build()
         s = self.spec
+        self.north_seeking = bool(s.get("north_seeking", True))
         cs = s.get("corrector_speed_kn", {"lo": 0.0, "hi": 0.0})
         if not (isinstance(cs, dict) and 0.0 <= float(cs.get("lo", -1)) <= float(cs.get("hi", -1))):
             raise SpecError("corrector_speed_kn", f"expected {{ lo, hi }} with 0 <= lo <= hi [kn], got {cs!r}")
@@ -511,8 +515,8 @@ class Heading(Device):
         self.lat = lat * DEG
 
     def reset(self, rng):
-        r1, r2 = rng.spawn(2)
-        self.chain.reset(r2)
+        self.chain.reset(rng)    # first, so that the error parts draw as they did before the corrector existed
+        (r1,) = rng.spawn(1)
         self.v_c = float(r1.uniform(self.cs_lo, self.cs_hi)) if self.cs_hi > 0 else 0.0
         lm, ls = _dist(self.spec, "corrector_latitude_error_deg", DEG)
         self.lat_c = float(np.clip(self.lat + lm + ls * float(r1.standard_normal()), -80 * DEG, 80 * DEG))
@@ -525,9 +529,9 @@ class Heading(Device):
     def steaming(self, kin, cols) -> np.ndarray:
         """Reading error from speed error, corrector and loop transient [rad] at the simulation samples."""
         t = cols["t"]
+        if t.size == 0 or not self.north_seeking:
+            return np.zeros(t.size)
         vn = kin.velocity_world()[:, 0]
-        if t.size == 0:
-            return np.zeros(0)
         if self._tl is None:  # settled before the trial: the loop starts at its settling point
             self._tl, self._vl = float(t[0]), float(vn[0])
         eps, self._tl, self._vl = SE.gyro_loop(t, vn, self.c, self.W, self.D, self.kappa, self._loop,
@@ -542,7 +546,8 @@ class Heading(Device):
         return {"heading": _wrap2pi(y)}
 
     def drawn(self):
-        return {"corrector_speed_mps": self.v_c, "corrector_latitude_rad": self.lat_c, "site_latitude_rad": self.lat,
+        return {"north_seeking": self.north_seeking, "corrector_speed_mps": self.v_c,
+                "corrector_latitude_rad": self.lat_c, "site_latitude_rad": self.lat,
                 "damping_ratio": self.zeta, "ballistic_kappa_rad_per_mps": self.kappa, "chain": self.chain.drawn()}
 
     def meta(self):
@@ -552,7 +557,7 @@ class Heading(Device):
         gm = self.spec.get("gauss_markov", {"sd": 0.0, "tau_s": 1.0})
         m.update({"drift_std_rad": float(gm["sd"]) * self.f, "drift_tau_s": float(gm["tau_s"]),
                   "resolution_rad": float(self.spec.get("resolution", 0.0)) * self.f})
-        if hasattr(self, "v_c"):
+        if hasattr(self, "v_c") and self.north_seeking:
             m.update({"corrector_speed_mps": self.v_c, "corrector_latitude_rad": self.lat_c})
         return m
 
@@ -597,13 +602,14 @@ class IMU(Device):
         self.acc = P.Chain([P.Misalignment(sd=float(s.get("misalignment_deg", 0.0)) * DEG, n_axes=3),
                             P.ScaleFactor(sa["mean"], sa["sd"], n_axes=3), P.Bias(am, asd, n_axes=3),
                             P.GaussMarkov(float(agm["tau_s"]), float(agm["sd"]) * ug, n_axes=3),
-                            P.RandomWalk(float(s.get("accel_random_walk_ug_rth", 0.0)) * ug / 60.0, n_axes=3),
-                            P.WhiteNoise(float(s.get("accel_noise_mps2", 0.0)), n_axes=3)])
+                            P.WhiteNoise(float(s.get("accel_noise_mps2", 0.0)), n_axes=3),
+                            # last (the parts add, so the order is immaterial): the other parts keep their draws
+                            P.RandomWalk(float(s.get("accel_random_walk_ug_rth", 0.0)) * ug / 60.0, n_axes=3)])
         self.gyr = P.Chain([P.Misalignment(sd=float(s.get("misalignment_deg", 0.0)) * DEG, n_axes=3),
                             P.ScaleFactor(sg["mean"], sg["sd"], n_axes=3), P.Bias(gm_, gsd, n_axes=3),
                             P.GaussMarkov(float(ggm["tau_s"]), float(ggm["sd"]) * dph, n_axes=3),
-                            P.RandomWalk(float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0, n_axes=3),
-                            P.WhiteNoise(float(s.get("gyro_noise_dps", 0.0)) * DEG, n_axes=3)])
+                            P.WhiteNoise(float(s.get("gyro_noise_dps", 0.0)) * DEG, n_axes=3),
+                            P.RandomWalk(float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0, n_axes=3)])
         self.clock = P.Resample(float(s["rate_hz"]))
         self.chain = P.Chain([self.clock])
 
