@@ -748,12 +748,13 @@ class ShaftTorque(ShaftDevice):
     metadata, is the true offset plus the residual error of that procedure (``zero_set_fs``)."""
 
     kind = "shaft_torque"
-    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs", "stern_tube_share", "stern_tube_loss_nominal"}
+    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs", "stern_tube_share", "stern_tube_loss_nominal",
+                  "stern_tube_loss_uncertainty"}
     channels = {"torque": ("N m", "shaft torque at the gauge")}
 
     def build(self):
         super().build()
-        for key in ("stern_tube_share", "stern_tube_loss_nominal"):
+        for key in ("stern_tube_share", "stern_tube_loss_nominal", "stern_tube_loss_uncertainty"):
             x = float(self.spec.get(key, 0.0))
             if not 0.0 <= x < 1.0:
                 raise SpecError(key, f"{x} not allowed (a fraction, 0 <= x < 1)")
@@ -787,6 +788,7 @@ class ShaftTorque(ShaftDevice):
         # the team's estimate of the torque lost between the gauge and the propeller (fraction of the
         # gauge torque): P_D = (1 − loss) P_S
         m["stern_tube_loss_nominal"] = float(self.spec.get("stern_tube_loss_nominal", 0.0))
+        m["stern_tube_loss_uncertainty"] = float(self.spec.get("stern_tube_loss_uncertainty", 0.0))
         return m
 
 

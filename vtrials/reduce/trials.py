@@ -129,7 +129,8 @@ def run_statistics(rec: Record, run: dict) -> dict:
             st = {**st, "mean": st["mean"] - z, "min": st["min"] - z, "max": st["max"] - z,
                   "calibration_std": math.hypot(float(m.get("zero_uncertainty_N_m", 0.0)),
                                                 float(m.get("scale_uncertainty", 0.0)) * (st["mean"] - z)),
-                  "stern_tube_loss_nominal": float(m.get("stern_tube_loss_nominal", 0.0))}
+                  "stern_tube_loss_nominal": float(m.get("stern_tube_loss_nominal", 0.0)),
+                  "stern_tube_loss_uncertainty": float(m.get("stern_tube_loss_uncertainty", 0.0))}
         shafts.setdefault(m["shaft_index"], {})["torque"] = st
     for name in kinds.get("shaft_rpm", []):
         k = rec.meta(name)["shaft_index"]
@@ -155,7 +156,9 @@ def run_statistics(rec: Record, run: dict) -> dict:
             power.append(p)
             shaft_power.append(sh["shaft_power"]["value"])
             # calibration (zero and scale of the torsionmeter): common to every run with this meter
-            syst.append(eta * 2 * math.pi * n["mean"] * q.get("calibration_std", 0.0))
+            # and the uncertainty of the assumed stern-tube loss, common to every run as well
+            syst.append(math.hypot(eta * 2 * math.pi * n["mean"] * q.get("calibration_std", 0.0),
+                                   float(q.get("stern_tube_loss_uncertainty", 0.0)) * sh["shaft_power"]["value"]))
     out["shafts"] = {str(k): v for k, v in sorted(shafts.items())}
     if power:
         out["power"] = Estimate(sum(p.value for p in power), math.sqrt(sum(p.std ** 2 for p in power)))
