@@ -418,11 +418,17 @@ def test_torsionmeter_reads_propeller_torque_plus_the_stern_tube_loss():
     to, ch = tm.process(cols)
     qi, ni = np.interp(to, t, q), np.interp(to, t, n)
     np.testing.assert_allclose(ch["torque"] - qi, 0.5 * 80.0 * ni, rtol=1e-9, atol=1e-9)
-    assert tm.meta()["stern_tube_loss_nominal"] == 0.005
+    # shaft power at the gauge minus delivered power, in steady running: 2π n · s c_F n
+    assert tm.loss_power(5.0) == pytest.approx(2 * math.pi * 5.0 * 0.5 * 80.0 * 5.0, rel=1e-12)
     v = load_vessel("patrol51")
     iset = InstrumentSet(v, 1, SITE, None, "test")
     for name, k in (("torque_port", 0), ("torque_starboard", 1)):
         assert iset.devices[name].friction == v.shafts[k].friction > 0
+    # the scoring reference of reported power: delivered power plus each gauge's loss (two shafts)
+    from vtrials.score.trials import gauge_power
+    n = [7.0, 7.5]
+    assert gauge_power(iset, 1.0e6, n) == pytest.approx(
+        1.0e6 + sum(2 * math.pi * x * 0.5 * v.shafts[k].friction * x for k, x in enumerate(n)), rel=1e-12)
 
 
 def test_torsionmeter_statistics_with_the_catalogue_errors():

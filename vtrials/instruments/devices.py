@@ -739,8 +739,8 @@ class ShaftTorque(ShaftDevice):
     tube: the propeller torque plus the friction of the stern-tube bearing and seal aft of the gauge,
     the share ``stern_tube_share`` of the shaft line's friction c_F n
     (:func:`vtrials.instruments.sensor_errors.gauge_torque`). Power from it is shaft power at the gauge,
-    P_S = 2π n Q_gauge; the delivered power is P_D = η P_S with the loss the team assumes between gauge
-    and propeller (``stern_tube_loss_nominal``, a fraction of the gauge torque: in the record's metadata).
+    P_S = 2π n Q_gauge (not the delivered power 2π n Q_P); :meth:`loss_power` gives the difference for
+    the scoring reference.
 
     Errors: gauge-factor / shear-modulus scale error, a zero offset (``bias_fs``), noise and
     resolution. Before the trial the team sets the zero (shaft turned slowly ahead and astern on the
@@ -748,17 +748,15 @@ class ShaftTorque(ShaftDevice):
     metadata, is the true offset plus the residual error of that procedure (``zero_set_fs``)."""
 
     kind = "shaft_torque"
-    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs", "stern_tube_share", "stern_tube_loss_nominal",
-                  "stern_tube_loss_uncertainty"}
+    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs", "stern_tube_share"}
     channels = {"torque": ("N m", "shaft torque at the gauge")}
 
     def build(self):
         super().build()
-        for key in ("stern_tube_share", "stern_tube_loss_nominal", "stern_tube_loss_uncertainty"):
-            x = float(self.spec.get(key, 0.0))
-            if not 0.0 <= x < 1.0:
-                raise SpecError(key, f"{x} not allowed (a fraction, 0 <= x < 1)")
         self.share = float(self.spec.get("stern_tube_share", 0.0))
+        if not 0.0 <= self.share <= 1.0:
+            raise SpecError("stern_tube_share", f"{self.share} not allowed (a fraction of the shaft line's "
+                                                f"friction, 0..1)")
 
     def reset(self, rng):
         r1, r2 = rng.spawn(2)
@@ -774,6 +772,11 @@ class ShaftTorque(ShaftDevice):
         return SE.gauge_torque(cols[f"prop_torque_{self.index}"], cols[f"shaft_n_{self.index}"], self.friction,
                                self.share)
 
+    def loss_power(self, rps: float) -> float:
+        """Power lost between the gauge and the propeller at shaft speed ``rps`` [rev/s] in steady running
+        [W]: 2π n · s c_F n (shaft power at the gauge minus delivered power)."""
+        return 2.0 * math.pi * rps * self.share * self.friction * rps
+
     def drawn(self):
         return {"zero_reading_N_m": self.zero_reading, "stern_tube_share": self.share,
                 "shaft_friction_N_m_s": self.friction, "chain": self.chain.drawn()}
@@ -785,10 +788,6 @@ class ShaftTorque(ShaftDevice):
         # the calibration certificate: standard uncertainties of the zero (after zero setting) and scale
         m["zero_uncertainty_N_m"] = float(self.spec.get("zero_set_fs", 0.0)) * (self.full_scale or 0.0)
         m["scale_uncertainty"] = _dist(self.spec, "scale")[1]
-        # the team's estimate of the torque lost between the gauge and the propeller (fraction of the
-        # gauge torque): P_D = (1 − loss) P_S
-        m["stern_tube_loss_nominal"] = float(self.spec.get("stern_tube_loss_nominal", 0.0))
-        m["stern_tube_loss_uncertainty"] = float(self.spec.get("stern_tube_loss_uncertainty", 0.0))
         return m
 
 

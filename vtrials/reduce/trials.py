@@ -9,11 +9,12 @@ sensor positions, nominal calibrations) and the tank prediction in the record's 
 * :func:`run_statistics` — per run: mean, σ, standard error, min, max of every channel over the run
   window [EXECUTE, FINEX] (seed 002 tabulates these for every run), SOG/COG from each tracking system
   (straight-line fit) and from the LORAN display, shaft power per shaft (P_S = 2π n Q from the torque and
-  r/min meters: power at the torsionmeter's gauge, between engine and stern tube) and the delivered
-  power P_D = (1 − l) P_S with the stern-tube loss l the team assumes (the torsionmeter's
-  ``stern_tube_loss_nominal``; P_D = η_S P_S is the usual definition of the shaft efficiency η_S), net
-  thrust (static load removed), relative wind. "power" is P_D — what the direct power method and the
-  calm-water truth (2π n Q_P at the propeller) are defined in; "shaft_power" is P_S.
+  r/min meters: the power in the shaft at the torsionmeter's gauge, between engine and stern tube —
+  it includes the stern-tube loss aft of the gauge, which the team cannot measure), net thrust
+  (static load removed), relative wind. "power" is this shaft power at the gauge throughout (runs,
+  spots, curve), as a trials team reports it; the direct power method is applied to it (its
+  corrections are power increments at unchanged r/min, where the stern-tube loss, a function of r/min,
+  does not change). The scoring reference is the same quantity (vtrials/score/trials.py).
 * :func:`reduce_standardization` — per spot: current elimination over its runs (two-run average,
   1:2:1 mean of means, ITTC mean of means), with the run-to-run scatter the all-runs ITTC iterative
   analysis leaves added to the tracking uncertainty; power corrected per run for the wind by the
@@ -128,9 +129,7 @@ def run_statistics(rec: Record, run: dict) -> dict:
             z = float(m.get("zero_reading_N_m", 0.0))
             st = {**st, "mean": st["mean"] - z, "min": st["min"] - z, "max": st["max"] - z,
                   "calibration_std": math.hypot(float(m.get("zero_uncertainty_N_m", 0.0)),
-                                                float(m.get("scale_uncertainty", 0.0)) * (st["mean"] - z)),
-                  "stern_tube_loss_nominal": float(m.get("stern_tube_loss_nominal", 0.0)),
-                  "stern_tube_loss_uncertainty": float(m.get("stern_tube_loss_uncertainty", 0.0))}
+                                                float(m.get("scale_uncertainty", 0.0)) * (st["mean"] - z))}
         shafts.setdefault(m["shaft_index"], {})["torque"] = st
     for name in kinds.get("shaft_rpm", []):
         k = rec.meta(name)["shaft_index"]
@@ -142,27 +141,20 @@ def run_statistics(rec: Record, run: dict) -> dict:
             shafts.setdefault(m["shaft_index"], {})["thrust"] = {**st, "mean": st["mean"] - m["nominal_static_load_N"]}
     for name in kinds.get("pitch_indicator", []):
         shafts.setdefault(rec.meta(name)["shaft_index"], {})["pitch"] = channels[name]["pitch"]
-    power, syst, shaft_power = [], [], []
+    power, syst = [], []
     for k in sorted(shafts):
         sh = shafts[k]
         if sh.get("torque") and sh.get("rps"):
             q, n = sh["torque"], sh["rps"]
             p = RS.shaft_power_estimate(Estimate(q["mean"], q["se"], max(q["n_eff"] - 1, 1)),
                                         Estimate(n["mean"], n["se"], max(n["n_eff"] - 1, 1)))
-            eta = 1.0 - float(q.get("stern_tube_loss_nominal", 0.0))  # gauge → propeller
-            sh["shaft_power"] = _est(p)
-            p = Estimate(eta * p.value, eta * p.std, p.dof)
             sh["power"] = _est(p)
             power.append(p)
-            shaft_power.append(sh["shaft_power"]["value"])
             # calibration (zero and scale of the torsionmeter): common to every run with this meter
-            # and the uncertainty of the assumed stern-tube loss, common to every run as well
-            syst.append(math.hypot(eta * 2 * math.pi * n["mean"] * q.get("calibration_std", 0.0),
-                                   float(q.get("stern_tube_loss_uncertainty", 0.0)) * sh["shaft_power"]["value"]))
+            syst.append(2 * math.pi * n["mean"] * q.get("calibration_std", 0.0))
     out["shafts"] = {str(k): v for k, v in sorted(shafts.items())}
     if power:
         out["power"] = Estimate(sum(p.value for p in power), math.sqrt(sum(p.std ** 2 for p in power)))
-        out["shaft_power"] = float(sum(shaft_power))
         out["power_calibration_std"] = math.sqrt(sum(x * x for x in syst))
     # relative wind (the first anemometer in name order: the mast)
     anem = kinds.get("anemometer", [])
