@@ -388,6 +388,9 @@ def test_imu_bias_random_walk_from_allan_deviation():
             av = _allan(ch[key], dt, m)
             X = np.column_stack([1.0 / tau, tau / 3.0]) / av[:, None]   # relative least squares
             coef = np.linalg.lstsq(X, np.ones_like(av), rcond=None)[0]
+            fit = coef[0] / tau + coef[1] * tau / 3.0  # second pass: weights from the fitted model, not the
+            X = np.column_stack([1.0 / tau, tau / 3.0]) / fit[:, None]   # scattered estimates (less biased)
+            coef = np.linalg.lstsq(X, av / fit, rcond=None)[0]
             out.append(math.sqrt(max(coef[1], 0.0)) / unit)
     for K, true in ((np.array(K_gyro), 1.0), (np.array(K_acc), 50.0)):
         se = K.std(ddof=1) / math.sqrt(K.size)
