@@ -341,8 +341,9 @@ class Knotmeter(Device):
 
     Pulse rate f = (1 + s)·((1 − d)·u_s − V₀)·c(θ)/k_nom above break-away (else 0), with u_s the
     axial water speed at the sensor, V₀ the friction slip, c(θ) = 1/(1 + (θ/θ_stall)⁴), k_nom the
-    nominal kn per count/s ("above break-away": while the impeller turns, see above). So displayed D = (1 + s)((1 − d) V − V₀) for steady straight flow, and the
-    true calibration is STW = V₀/(1 − d) + D/((1 + s)(1 − d))."""
+    nominal kn per count/s ("above break-away": while the impeller turns, see above). So displayed
+    D = (1 + s)((1 − d) V − V₀) for steady straight flow, and the true calibration is
+    STW = V₀/(1 − d) + D/((1 + s)(1 − d))."""
 
     kind = "knotmeter"
     extra_keys = {"nominal_kn_per_count_s", "count_window_s", "cycle_s", "breakaway_kn", "boundary_layer_deficit",
