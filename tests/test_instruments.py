@@ -20,7 +20,8 @@ SITE = {"transponders": [[-10000.0, -6000.0], [-10000.0, 6000.0]], "transponder_
 IDEAL_IMU = {"accel_bias_ug": 0.0, "accel_gauss_markov_ug": {"sd": 0.0, "tau_s": 100.0}, "accel_noise_mps2": 0.0,
              "accel_scale": {"mean": 0.0, "sd": 0.0}, "gyro_bias_dph": 0.0,
              "gyro_gauss_markov_dph": {"sd": 0.0, "tau_s": 100.0}, "gyro_noise_dps": 0.0,
-             "gyro_scale": {"mean": 0.0, "sd": 0.0}, "misalignment_deg": 0.0, "rate_hz": 20.0}
+             "gyro_scale": {"mean": 0.0, "sd": 0.0}, "misalignment_deg": 0.0, "rate_hz": 20.0,
+             "accel_random_walk_ug_rth": 0.0, "gyro_random_walk_dph_rth": 0.0}
 
 
 def _columns(sim):

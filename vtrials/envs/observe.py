@@ -11,8 +11,10 @@ error e_GM propagated exactly between control instants (e_{k+1} = a e_k + σ√(
 the same discretisation as :class:`vtrials.instruments.parts.GaussMarkov`) and white noise w per
 sample. GNSS drops a fix with the catalogue's probability (the previous fix is held). The part
 values are read from the ship's own suite (catalogue + ``models/<ship>/instruments.toml``) through
-an InstrumentSet, so overrides there apply here too. Left out: the devices' sampling clocks and the
-gyrocompass latency (0.1 s; below one control period), lever-arm terms other than the yaw rate's.
+an InstrumentSet, so overrides there apply here too. The gyrocompass adds its speed error less its
+corrector's (settings drawn per episode; :mod:`vtrials.instruments.sensor_errors`). Left out: the
+devices' sampling clocks, the gyrocompass latency (0.1 s; below one control period) and its ballistic
+transients (84-min loop; an episode starts settled), lever-arm terms other than the yaw rate's.
 
 Each ship draws from its own Generator (seeded per episode), with the episode's white noise drawn
 up front, so a ship's observations do not depend on how many ships run together.
@@ -25,6 +27,7 @@ import math
 
 import numpy as np
 
+from vtrials.instruments import sensor_errors as SE
 from vtrials.units import DEG
 
 # channel order of the measured arrays
@@ -47,6 +50,14 @@ class ErrorParts:
     noise: float = 0.0
     resolution: float = 0.0
     dropout_p: float = 0.0
+    # gyrocompass speed error (heading channel): site latitude [rad], corrector speed range [m/s] and
+    # the corrector latitude's error (mean, sd) [rad]; north_seeking False: none
+    north_seeking: bool = False
+    latitude: float = 0.0
+    corrector_lo: float = 0.0
+    corrector_hi: float = 0.0
+    corrector_lat_mean: float = 0.0
+    corrector_lat_sd: float = 0.0
 
 
 def _dist(spec: dict, key: str, f: float = 1.0) -> tuple[float, float]:
@@ -106,6 +117,10 @@ def suite_parts(vessel) -> tuple[dict[str, ErrorParts], dict[str, np.ndarray], d
                 parts[ch] = ErrorParts(noise=float(s.get("velocity_noise_mps", 0.0)), dropout_p=base.dropout_p)
             else:
                 parts[ch] = base
+        elif ch == "heading" and getattr(d, "north_seeking", False):
+            lm, ls = _dist(s, "corrector_latitude_error_deg", DEG)
+            parts[ch] = dataclasses.replace(_parts(s, d.f), north_seeking=True, latitude=d.lat, corrector_lo=d.cs_lo,
+                                            corrector_hi=d.cs_hi, corrector_lat_mean=lm, corrector_lat_sd=ls)
         else:
             parts[ch] = _parts(s, d.f)
     index = {"rudder": int(iset.devices[dev["rudder"]].index),
@@ -139,6 +154,9 @@ class ObservationModel:
         self.drop = np.zeros((n, self.horizon), dtype=bool)
         self.k = np.zeros(n, dtype=np.int64)
         self.last = np.zeros((n, C))
+        self.gyro = parts["heading"]
+        self.corr_speed = np.zeros(n)
+        self.corr_lat = np.full(n, self.gyro.latitude)
 
     def reset(self, ship: int, rng: np.random.Generator) -> None:
         """New instrument draws for ship ``ship`` (its episode's whole noise sequence)."""
@@ -151,6 +169,11 @@ class ObservationModel:
         self.drop[ship] = rng.random(self.horizon) < self.drop_p
         self.drop[ship, 0] = False
         self.k[ship] = 0
+        g = self.gyro
+        if g.north_seeking:  # drawn last: the other parts keep their draws
+            self.corr_speed[ship] = float(rng.uniform(g.corrector_lo, g.corrector_hi)) if g.corrector_hi > 0 else 0.0
+            self.corr_lat[ship] = float(np.clip(g.latitude + g.corrector_lat_mean + g.corrector_lat_sd
+                                                * rng.standard_normal(), -80 * DEG, 80 * DEG))
 
     def sample(self, truth: dict, idx: np.ndarray | None = None) -> np.ndarray:
         """Readings (len(idx), channels) of ships ``idx`` (default all) from their truth arrays
@@ -171,6 +194,11 @@ class ObservationModel:
         ve = truth["ve"] + r * (c * xg - s * yg)
         m = np.empty((idx.size, C))
         m[:, 0] = psi
+        if self.gyro.north_seeking:  # speed error less the corrector's (reading − true)
+            m[:, 0] += SE.speed_error(truth["vn"], self.gyro.latitude) - np.where(
+                self.corr_speed[idx] > 0,
+                np.arcsin(np.clip(self.corr_speed[idx] * c / (SE.EARTH_RADIUS * SE.EARTH_RATE
+                                                              * np.cos(self.corr_lat[idx])), -1.0, 1.0)), 0.0)
         m[:, 1] = r
         m[:, 2] = truth["x"] + c * xg - s * yg
         m[:, 3] = truth["y"] + s * xg + c * yg

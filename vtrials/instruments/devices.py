@@ -17,6 +17,7 @@ import numpy as np
 
 from vtrials.units import DEG, KNOT, RPM
 from vtrials.instruments import parts as P
+from vtrials.instruments import sensor_errors as SE
 from vtrials.instruments.kinematics import SiteKinematics
 
 UNIT_FACTORS = {"m": 1.0, "deg": DEG, "kn": KNOT, "m/s": 1.0, "rpm": RPM, "N m": 1.0, "N": 1.0, "1": 1.0,
@@ -332,17 +333,21 @@ class Knotmeter(Device):
     friction (it does not start below a break-away speed and slips by a constant amount above it),
     and under-reads when the flow meets it at an angle (rolling at low speed: the roll rate times the
     sensor's depth below the roll axis adds cross-flow; beyond the stall angle the response drops).
+    Break-away with hysteresis (:func:`vtrials.instruments.sensor_errors.breakaway_hysteresis`): at rest
+    it starts only above the break-away speed V_b (static friction), once turning it stops only below
+    the stall speed V_s = r V_b (kinetic friction, r = ``stall_to_breakaway``).
     Counts are accumulated over a 10-s window every 20 s; the display shows counts/10 s × the nominal
     0.3 kn per count/s and holds it for the cycle.
 
     Pulse rate f = (1 + s)·((1 − d)·u_s − V₀)·c(θ)/k_nom above break-away (else 0), with u_s the
     axial water speed at the sensor, V₀ the friction slip, c(θ) = 1/(1 + (θ/θ_stall)⁴), k_nom the
-    nominal kn per count/s. So displayed D = (1 + s)((1 − d) V − V₀) for steady straight flow, and the
-    true calibration is STW = V₀/(1 − d) + D/((1 + s)(1 − d))."""
+    nominal kn per count/s ("above break-away": while the impeller turns, see above). So displayed
+    D = (1 + s)((1 − d) V − V₀) for steady straight flow, and the true calibration is
+    STW = V₀/(1 − d) + D/((1 + s)(1 − d))."""
 
     kind = "knotmeter"
     extra_keys = {"nominal_kn_per_count_s", "count_window_s", "cycle_s", "breakaway_kn", "boundary_layer_deficit",
-                  "roll_stall_deg", "slip_kn"}
+                  "roll_stall_deg", "slip_kn", "stall_to_breakaway"}
     channels = {"counts": ("1", "impeller pulses counted in the window"),
                 "speed": ("m s-1", "displayed speed: counts per second × the nominal calibration")}
 
@@ -352,6 +357,10 @@ class Knotmeter(Device):
         self.window = float(s.get("count_window_s", 10.0))
         self.cycle = float(s.get("cycle_s", 20.0))
         self.stall = float(s.get("roll_stall_deg", 20.0)) * DEG
+        self.stall_ratio = float(s.get("stall_to_breakaway", 1.0))
+        if not 0.0 <= self.stall_ratio <= 1.0:
+            raise SpecError("stall_to_breakaway", f"{self.stall_ratio} not allowed (0..1: the impeller stops at or "
+                                                  f"below the speed at which it starts)")
         self.chain = P.Chain([P.WindowAverage(self.window, period=self.cycle, output="count",
                                               pulses_per_unit=1.0)])
 
@@ -366,10 +375,13 @@ class Knotmeter(Device):
         self.s = sm + ss * float(r1.standard_normal())
         slm, sls = _dist(s, "slip_kn", KNOT)
         self.v0 = slm + sls * float(r1.standard_normal())
+        self.v_stall = self.stall_ratio * self.v_break
+        self._turning = False
         self.chain.reset(r2)
 
     def rate(self, kin) -> np.ndarray:
-        """True pulse rate [count/s] at the sensor."""
+        """True pulse rate [count/s] at the sensor (advances the impeller's turning/stopped state: call once
+        per chunk, in order)."""
         v = kin.velocity_body(through_water=True)
         u = v[:, 0]
         cross = np.hypot(v[:, 1], v[:, 2])
@@ -377,7 +389,9 @@ class Knotmeter(Device):
         c = 1.0 / (1.0 + (theta / self.stall) ** 4)
         w = (1.0 - self.d) * u
         f = (1.0 + self.s) * np.maximum(w - self.v0, 0.0) * c / self.k_nom
-        return np.where(w > self.v_break, f, 0.0)
+        on, self._turning = SE.breakaway_hysteresis(np.ascontiguousarray(w), self.v_break, self.v_stall,
+                                                    self._turning)
+        return np.where(on, f, 0.0)
 
     def process(self, cols):
         kin = SiteKinematics(cols, self.site)
@@ -390,7 +404,8 @@ class Knotmeter(Device):
 
     def drawn(self):
         a, b = self.true_calibration()
-        return {"breakaway_mps": self.v_break, "boundary_layer_deficit": self.d, "scale": self.s,
+        return {"breakaway_mps": self.v_break, "stall_mps": self.v_stall, "boundary_layer_deficit": self.d,
+                "scale": self.s,
                 "slip_mps": self.v0, "true_calibration_intercept_mps": a, "true_calibration_slope": b,
                 "chain": self.chain.drawn()}
 
@@ -402,17 +417,36 @@ class Knotmeter(Device):
 
 
 class EMLog(Device):
-    """Electromagnetic log: water speed at the sensor along the ship, with calibration scale and offset
-    errors, noise and resolution; no output astern (it shows zero: seed 002)."""
+    """Electromagnetic log: the water velocity at the sensor along its sensing axis (cosine law: the
+    flow angle at the sensor — drift angle, leeway and the yaw rate's lever arm — and the axis's yaw
+    misalignment ε enter as V cos(β − ε)), changed by heel (the sensor moves in the hull's boundary
+    layer: factor 1 + k_h |φ|, ``heel_sensitivity_per_deg`` = k_h per degree, modelled assumption), then
+    calibration scale and offset errors, noise and resolution; no output astern (it shows zero:
+    seed 002). See :func:`vtrials.instruments.sensor_errors.em_log_response`."""
 
     kind = "em_log"
+    extra_keys = {"heel_sensitivity_per_deg"}
     channels = {"speed": ("m s-1", "EM log speed through the water (zero astern)")}
 
+    def build(self):
+        sp = {k: v for k, v in self.spec.items() if k != "misalignment_deg"}
+        self.chain = value_chain(sp, self.f, None)
+        self.k_heel = float(self.spec.get("heel_sensitivity_per_deg", 0.0)) / DEG
+
+    def reset(self, rng):
+        self.chain.reset(rng)    # first, so that the error parts draw as they did before the misalignment existed
+        (r1,) = rng.spawn(1)
+        self.eps = float(r1.standard_normal()) * float(self.spec.get("misalignment_deg", 0.0)) * DEG
+
     def measurand(self, kin, cols):
-        return kin.velocity_body(through_water=True)[:, 0]
+        v = kin.velocity_body(through_water=True)
+        return SE.em_log_response(v[:, 0], v[:, 1], cols["roll"], self.eps, self.k_heel)
 
     def outputs(self, t, y):
         return {"speed": np.maximum(y, 0.0)}
+
+    def drawn(self):
+        return {"misalignment_rad": self.eps, "heel_sensitivity_per_rad": self.k_heel, "chain": self.chain.drawn()}
 
 
 class DopplerLog(Device):
@@ -444,24 +478,88 @@ class DopplerLog(Device):
 
 # ------------------------------------------------------------------------------------ attitude, IMU
 class Heading(Device):
-    """Gyrocompass: heading with bias, slow drift, noise, resolution and a small lag; output 0..2π."""
+    """Gyrocompass: heading with the speed (steaming) error its corrector leaves, the ballistic
+    deflection of its north-seeking loop after changes of north velocity (speed or course changes),
+    then bias, slow drift, noise, resolution and a small lag; output 0..2π.
+
+    Speed error and loop: :mod:`vtrials.instruments.sensor_errors` (Bowditch; Schuler tuning). The
+    speed/latitude corrector is set once per trial to a speed drawn from ``corrector_speed_kn``
+    (``{lo, hi}``; 0 = corrector off: the full speed error) and to the site latitude plus an error
+    drawn from ``corrector_latitude_error_deg``; the corrector removes arcsin(V_c cos ψ/(R_E Ω cos φ_c)),
+    and the loop is Schuler-tuned at φ_c (its latitude setting), so a mis-set latitude also leaves a
+    ballistic transient (damping ratio ``damping_ratio``). The site latitude is the scenario's
+    ``[site] latitude_deg``. The team knows the corrector settings (they are on the dial: meta).
+    ``north_seeking = false`` describes a heading reference that does not seek north by gravity and
+    earth rate (a free-running model's heading gyro, a fibre-optic AHRS slaved to GNSS): no speed error
+    and no ballistic deflection."""
 
     kind = "heading"
+    extra_keys = {"corrector_speed_kn", "corrector_latitude_error_deg", "damping_ratio", "north_seeking"}
     channels = {"heading": ("rad", "gyrocompass heading (0..2π, clockwise from north)")}
 
+    def build(self):
+        super().build()
+        s = self.spec
+        self.north_seeking = bool(s.get("north_seeking", True))
+        cs = s.get("corrector_speed_kn", {"lo": 0.0, "hi": 0.0})
+        if not (isinstance(cs, dict) and 0.0 <= float(cs.get("lo", -1)) <= float(cs.get("hi", -1))):
+            raise SpecError("corrector_speed_kn", f"expected {{ lo, hi }} with 0 <= lo <= hi [kn], got {cs!r}")
+        self.cs_lo, self.cs_hi = float(cs["lo"]) * KNOT, float(cs["hi"]) * KNOT
+        self.zeta = float(s.get("damping_ratio", 0.33))
+        if not 0.0 <= self.zeta < 1.0:
+            raise SpecError("damping_ratio", f"{self.zeta} not allowed (0 <= damping_ratio < 1: an oscillating "
+                                             f"north-seeking loop)")
+        lat = float(self.team.get("site", {}).get("latitude_deg", 38.0))
+        if not -80.0 <= lat <= 80.0:
+            raise SpecError("latitude_deg", f"site latitude {lat} deg: a gyrocompass does not settle beyond "
+                                            f"±80° (allowed -80..80)")
+        self.lat = lat * DEG
+
+    def reset(self, rng):
+        self.chain.reset(rng)    # first, so that the error parts draw as they did before the corrector existed
+        (r1,) = rng.spawn(1)
+        self.v_c = float(r1.uniform(self.cs_lo, self.cs_hi)) if self.cs_hi > 0 else 0.0
+        lm, ls = _dist(self.spec, "corrector_latitude_error_deg", DEG)
+        self.lat_c = float(np.clip(self.lat + lm + ls * float(r1.standard_normal()), -80 * DEG, 80 * DEG))
+        self.c, self.W, self.D = SE.loop_constants(self.lat, self.lat_c, self.zeta)
+        self.kappa = SE.ballistic_kappa(self.lat, self.lat_c)
+        self._loop = np.zeros(2)
+        self._tl = None
+        self._vl = 0.0
+
+    def steaming(self, kin, cols) -> np.ndarray:
+        """Reading error from speed error, corrector and loop transient [rad] at the simulation samples."""
+        t = cols["t"]
+        if t.size == 0 or not self.north_seeking:
+            return np.zeros(t.size)
+        vn = kin.velocity_world()[:, 0]
+        if self._tl is None:  # settled before the trial: the loop starts at its settling point
+            self._tl, self._vl = float(t[0]), float(vn[0])
+        eps, self._tl, self._vl = SE.gyro_loop(t, vn, self.c, self.W, self.D, self.kappa, self._loop,
+                                               self._tl, self._vl)
+        corr = SE.speed_error(self.v_c * np.cos(cols["heading"]), self.lat_c) if self.v_c > 0 else 0.0
+        return SE.speed_error(vn, self.lat) - eps - corr
+
     def measurand(self, kin, cols):
-        return cols["heading"]
+        return cols["heading"] + self.steaming(kin, cols)
 
     def outputs(self, t, y):
         return {"heading": _wrap2pi(y)}
 
+    def drawn(self):
+        return {"north_seeking": self.north_seeking, "corrector_speed_mps": self.v_c,
+                "corrector_latitude_rad": self.lat_c, "site_latitude_rad": self.lat,
+                "damping_ratio": self.zeta, "ballistic_kappa_rad_per_mps": self.kappa, "chain": self.chain.drawn()}
+
     def meta(self):
         m = super().meta()
         # the maker's drift specification (what the team knows): the slow wander's standard deviation
-        # and correlation time, and the resolution
+        # and correlation time, and the resolution; the corrector settings as set on the dial
         gm = self.spec.get("gauss_markov", {"sd": 0.0, "tau_s": 1.0})
         m.update({"drift_std_rad": float(gm["sd"]) * self.f, "drift_tau_s": float(gm["tau_s"]),
                   "resolution_rad": float(self.spec.get("resolution", 0.0)) * self.f})
+        if hasattr(self, "v_c") and self.north_seeking:
+            m.update({"corrector_speed_mps": self.v_c, "corrector_latitude_rad": self.lat_c})
         return m
 
 
@@ -478,12 +576,15 @@ class Attitude(Device):
 
 class IMU(Device):
     """Strapdown motion package at its site: triaxial accelerometers (specific force, including the
-    lever-arm centripetal and tangential terms) and rate gyros, each with bias, bias instability,
-    noise, scale-factor error and a common misalignment."""
+    lever-arm centripetal and tangential terms) and rate gyros, each with bias, bias instability
+    (Gauss–Markov), bias random walk (rate random walk of the gyros, IEEE Std 952-1997 Annex C
+    coefficient K: Allan deviation K √(τ/3); the accelerometers' bias random walk likewise), noise,
+    scale-factor error and a common misalignment."""
 
     kind = "imu"
     extra_keys = {"accel_bias_ug", "accel_gauss_markov_ug", "accel_noise_mps2", "accel_scale", "gyro_bias_dph",
-                  "gyro_gauss_markov_dph", "gyro_noise_dps", "gyro_scale"}
+                  "gyro_gauss_markov_dph", "gyro_noise_dps", "gyro_scale", "accel_random_walk_ug_rth",
+                  "gyro_random_walk_dph_rth"}
     channels = {"ax": ("m s-2", "specific force x"), "ay": ("m s-2", "specific force y"),
                 "az": ("m s-2", "specific force z (≈ −g at rest)"), "p": ("rad s-1", "roll rate"),
                 "q": ("rad s-1", "pitch rate"), "r": ("rad s-1", "yaw rate")}
@@ -502,11 +603,14 @@ class IMU(Device):
         self.acc = P.Chain([P.Misalignment(sd=float(s.get("misalignment_deg", 0.0)) * DEG, n_axes=3),
                             P.ScaleFactor(sa["mean"], sa["sd"], n_axes=3), P.Bias(am, asd, n_axes=3),
                             P.GaussMarkov(float(agm["tau_s"]), float(agm["sd"]) * ug, n_axes=3),
-                            P.WhiteNoise(float(s.get("accel_noise_mps2", 0.0)), n_axes=3)])
+                            P.WhiteNoise(float(s.get("accel_noise_mps2", 0.0)), n_axes=3),
+                            # last (the parts add, so the order is immaterial): the other parts keep their draws
+                            P.RandomWalk(float(s.get("accel_random_walk_ug_rth", 0.0)) * ug / 60.0, n_axes=3)])
         self.gyr = P.Chain([P.Misalignment(sd=float(s.get("misalignment_deg", 0.0)) * DEG, n_axes=3),
                             P.ScaleFactor(sg["mean"], sg["sd"], n_axes=3), P.Bias(gm_, gsd, n_axes=3),
                             P.GaussMarkov(float(ggm["tau_s"]), float(ggm["sd"]) * dph, n_axes=3),
-                            P.WhiteNoise(float(s.get("gyro_noise_dps", 0.0)) * DEG, n_axes=3)])
+                            P.WhiteNoise(float(s.get("gyro_noise_dps", 0.0)) * DEG, n_axes=3),
+                            P.RandomWalk(float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0, n_axes=3)])
         self.clock = P.Resample(float(s["rate_hz"]))
         self.chain = P.Chain([self.clock])
 
@@ -612,9 +716,11 @@ class ShaftDevice(Device):
 
     full_scale_key = "full_scale"
 
-    def __init__(self, name, spec, site_name, site, team, index: int, full_scale: float | None):
+    def __init__(self, name, spec, site_name, site, team, index: int, full_scale: float | None,
+                 friction: float = 0.0):
         self.index = index
         self.full_scale = full_scale
+        self.friction = float(friction)  # the shaft line's friction coefficient c_F [N m s] (ship model)
         super().__init__(name, spec, site_name, site, team)
 
     def build(self):
@@ -630,7 +736,12 @@ class ShaftDevice(Device):
 
 
 class ShaftTorque(ShaftDevice):
-    """Strain-gauge torsionmeter: the torque the shaft transmits to the propeller.
+    """Strain-gauge torsionmeter: the torque in the shaft at the gauge, between the engine and the stern
+    tube: the propeller torque plus the friction of the stern-tube bearing and seal aft of the gauge,
+    the share ``stern_tube_share`` of the shaft line's friction c_F n
+    (:func:`vtrials.instruments.sensor_errors.gauge_torque`). Power from it is shaft power at the gauge,
+    P_S = 2π n Q_gauge (not the delivered power 2π n Q_P); :meth:`loss_power` gives the difference for
+    the scoring reference.
 
     Errors: gauge-factor / shear-modulus scale error, a zero offset (``bias_fs``), noise and
     resolution. Before the trial the team sets the zero (shaft turned slowly ahead and astern on the
@@ -638,8 +749,15 @@ class ShaftTorque(ShaftDevice):
     metadata, is the true offset plus the residual error of that procedure (``zero_set_fs``)."""
 
     kind = "shaft_torque"
-    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs"}
-    channels = {"torque": ("N m", "shaft torque")}
+    extra_keys = {"bias_fs", "noise_fs", "resolution_fs", "zero_set_fs", "stern_tube_share"}
+    channels = {"torque": ("N m", "shaft torque at the gauge")}
+
+    def build(self):
+        super().build()
+        self.share = float(self.spec.get("stern_tube_share", 0.0))
+        if not 0.0 <= self.share <= 1.0:
+            raise SpecError("stern_tube_share", f"{self.share} not allowed (a fraction of the shaft line's "
+                                                f"friction, 0..1)")
 
     def reset(self, rng):
         r1, r2 = rng.spawn(2)
@@ -652,10 +770,17 @@ class ShaftTorque(ShaftDevice):
         self.zero_reading = offset + zs * float(r1.standard_normal())
 
     def measurand(self, kin, cols):
-        return cols[f"prop_torque_{self.index}"]
+        return SE.gauge_torque(cols[f"prop_torque_{self.index}"], cols[f"shaft_n_{self.index}"], self.friction,
+                               self.share)
+
+    def loss_power(self, rps: float) -> float:
+        """Power lost between the gauge and the propeller at shaft speed ``rps`` [rev/s] in steady running
+        [W]: 2π n · s c_F n (shaft power at the gauge minus delivered power)."""
+        return 2.0 * math.pi * rps * self.share * self.friction * rps
 
     def drawn(self):
-        return {"zero_reading_N_m": self.zero_reading, "chain": self.chain.drawn()}
+        return {"zero_reading_N_m": self.zero_reading, "stern_tube_share": self.share,
+                "shaft_friction_N_m_s": self.friction, "chain": self.chain.drawn()}
 
     def meta(self):
         m = super().meta()

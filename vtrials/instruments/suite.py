@@ -224,7 +224,7 @@ class InstrumentSet:
                 pk = [p.name for p in v.propellers].index(v.shafts[k].propeller)
                 pos = np.array([v.propellers[pk].x, v.propellers[pk].y, v.propellers[pk].z])
                 return cls(e.name, spec, e.site or f"shaft {e.shaft}", site if e.site else pos, self.team, pk,
-                           e.full_scale)
+                           e.full_scale, friction=v.shafts[k].friction)
             if cls is RudderAngle:
                 names = [r.name for r in v.rudders]
                 if e.rudder not in names:

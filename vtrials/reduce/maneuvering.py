@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from vtrials.records.netcdf import Record
+from vtrials.reduce import gyro as GY
 from vtrials.reduce import imo as IMO
 from vtrials.reduce import reach as RE
 from vtrials.reduce import spiral as SPI
@@ -64,6 +65,13 @@ class Channels:
         self.gyro_resolution = float(gm.get("resolution_rad", 0.0))
         if self.heading is not None:
             self.heading = np.unwrap(self.heading)
+            # the gyro's residual speed error, corrected from the team's track, the site latitude and
+            # the corrector settings (vtrials/reduce/gyro.py)
+            lat = (rec.team.get("site") or {}).get("latitude_deg")
+            if lat is not None and "corrector_speed_mps" in gm:
+                self.heading = GY.correct_heading(self.t_heading, self.heading, self.t, self.north,
+                                                  math.radians(float(lat)), float(gm["corrector_speed_mps"]),
+                                                  float(gm["corrector_latitude_rad"]))
         a = k.get("attitude", [None])[0]
         self.t_roll, self.roll = rec.channel(a, "roll") if a else (None, None)
         self.t_pitch, self.pitch = rec.channel(a, "pitch") if a else (None, None)

@@ -8,8 +8,13 @@ sensor positions, nominal calibrations) and the tank prediction in the record's 
 
 * :func:`run_statistics` — per run: mean, σ, standard error, min, max of every channel over the run
   window [EXECUTE, FINEX] (seed 002 tabulates these for every run), SOG/COG from each tracking system
-  (straight-line fit) and from the LORAN display, shaft power per shaft (2π n Q from the torque and
-  r/min meters), net thrust (static load removed), relative wind.
+  (straight-line fit) and from the LORAN display, shaft power per shaft (P_S = 2π n Q from the torque and
+  r/min meters: the power in the shaft at the torsionmeter's gauge, between engine and stern tube —
+  it includes the stern-tube loss aft of the gauge, which the team cannot measure), net thrust
+  (static load removed), relative wind. "power" is this shaft power at the gauge throughout (runs,
+  spots, curve), as a trials team reports it; the direct power method is applied to it (its
+  corrections are power increments at unchanged r/min, where the stern-tube loss, a function of r/min,
+  does not change). The scoring reference is the same quantity (vtrials/score/trials.py).
 * :func:`reduce_standardization` — per spot: current elimination over its runs (two-run average,
   1:2:1 mean of means, ITTC mean of means), with the run-to-run scatter the all-runs ITTC iterative
   analysis leaves added to the tracking uncertainty; power corrected per run for the wind by the

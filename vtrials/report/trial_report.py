@@ -71,7 +71,7 @@ def _std_figures(tr: dict, out: Path) -> list[str]:
         vv = np.linspace(*red["curve"]["speed_range"], 100)
         a1.plot(vv / KNOT, curve_power(red["curve"], vv) * KW, "C0--", lw=1, label="fitted curve")
     a1.set_xlabel("speed through water [kn]")
-    a1.set_ylabel("delivered power [kW]")
+    a1.set_ylabel("shaft power at the torsionmeters [kW]")
     a1.set_title(f"{name}: speed–power")
     a1.legend(fontsize=8)
     a1.grid(alpha=0.3)

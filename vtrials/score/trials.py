@@ -5,6 +5,10 @@ Truth references (never the reduction run on cleaner data):
 
 * a run's speed through water, ground speed, current, power: means over its window [EXECUTE, FINEX]
   of the true state (:func:`vtrials.trials.crew.window_truth`);
+* power is reduced as a trials team has it — shaft power at the torsionmeters' gauges, P_S = 2π n Q_gauge,
+  which carries the stern-tube loss aft of the gauge — so its reference is the same quantity: the true
+  delivered power 2π n Q_P plus each gauge's loss 2π n · s c_F n (:func:`gauge_power`); the delivered
+  power stays in the truth as ``delivered_power``;
 * a spot's speed through water: the heading-balanced mean ½(mean over the base-course runs + mean
   over the reciprocal runs) — the quantity current elimination estimates;
 * the speed–power curve: the calm-water steady states at the shaft settings the crew used
@@ -52,16 +56,33 @@ def true_curve(points: list[dict]):
     return (lambda x: np.exp(f(np.log(np.asarray(x, float))))), (float(v.min()), float(v.max()))
 
 
+def gauge_power(iset, delivered: float, rps: list[float]) -> float:
+    """Shaft power at the torsionmeters' gauges [W] from the true delivered power [W] and the shaft
+    speeds [rev/s] per propeller: P_D + Σ 2π n · s c_F n over the shafts that carry a torsionmeter
+    (:meth:`vtrials.instruments.devices.ShaftTorque.loss_power`)."""
+    seen = set()
+    p = float(delivered)
+    for dev in iset.devices.values():
+        if dev.kind == "shaft_torque" and dev.index not in seen and dev.index < len(rps):
+            seen.add(dev.index)
+            p += dev.loss_power(float(rps[dev.index]))
+    return p
+
+
+def _at_gauge(iset, ref: dict, rps: list[float]) -> dict:
+    return {**ref, "power": gauge_power(iset, ref["power"], rps), "delivered_power": ref["power"]}
+
+
 def score_standardization(reduced: dict, res, name: str) -> dict:
     crew = res.crew
-    truth = _truth_of(crew, name)
+    truth = {k: _at_gauge(crew.iset, r, [sh["rps"] for sh in r["shafts"]]) for k, r in _truth_of(crew, name).items()}
     runs = []
     for r in reduced["runs"]:
         tr = truth[r["run"]]
         runs.append({"run": r["run"], "label": r["label"], "sog": _cmp(r["vg"], tr["sog"]),
                      "power_measured": _cmp(r["power"], tr["power"]), "true_stw": tr["stw"],
                      "true_current": [tr["current_n"], tr["current_e"]], "true_wind_speed": tr["wind_speed"]})
-    calm = res.calm_water.get(name, [])
+    calm = [_at_gauge(crew.iset, p, p["rps"]) for p in res.calm_water.get(name, [])]
     P_true, (vlo, vhi) = true_curve(calm) if len(calm) >= 2 else (None, (math.nan, math.nan))
     spots = []
     worst = 0.0

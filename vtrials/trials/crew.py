@@ -33,6 +33,7 @@ from vtrials.physics import steering as H
 from vtrials.trials.agenda import Agenda, Run
 from vtrials.physics.dynamics import NV_PSI_U
 from vtrials.errors import SimulationError
+from vtrials.instruments import sensor_errors as SE
 from vtrials.instruments.devices import UNIT_FACTORS
 from vtrials.physics.propulsion import MODE_NAMES, S_CP
 from vtrials.physics.simulator import Simulator
@@ -330,11 +331,31 @@ class Crew:
         d = {"rps": [get(n, "rps") for n in self._shaft_inst["rps"]],
              "torque": [torque(n) for n in self._shaft_inst["torque"]],
              "heading": get(self._gyro, "heading"), "log": None}
+        if d["heading"] is not None:
+            d["heading"] = self._gyro_corrected(t0, *d["heading"])
         if self._log_inst is not None:
             kind = self.iset.devices[self._log_inst].kind
             d["log"] = get(self._log_inst, "u" if kind == "doppler_log" else "speed")
             d["log_noise"] = self._log_noise
         return d
+
+    def _gyro_corrected(self, t0: float, t: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The gyro heading as the officer of the watch reads it: less the residual speed error of the
+        compass's corrector settings at the ship's north velocity over the window (from the tracking
+        fixes) and the site latitude (the speed-error table; vtrials.instruments.sensor_errors)."""
+        m = self.iset.devices[self._gyro].meta()
+        if "corrector_speed_mps" not in m or self._track is None or h.size == 0:
+            return t, h
+        tt, c = self.iset.window(self._track, t0)
+        ok = np.isfinite(c["north"])
+        if np.count_nonzero(ok) < 2 or np.ptp(tt[ok]) <= 0.0:
+            return t, h
+        vn = float(np.polyfit(tt[ok] - tt[ok][0], c["north"][ok], 1)[0])
+        lat = math.radians(float(self.iset.team.get("site", {}).get("latitude_deg", 38.0)))
+        err = SE.speed_error(vn, lat)
+        if m["corrector_speed_mps"] > 0.0:
+            err = err - SE.speed_error(m["corrector_speed_mps"] * np.cos(h), m["corrector_latitude_rad"])
+        return t, h - err
 
     # ------------------------------------------------------------------ orders
     def set_shafts(self, run: Run) -> bool:
