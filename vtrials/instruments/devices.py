@@ -191,6 +191,10 @@ class GNSS(Device):
                  P.GaussMarkov(float(gm["tau_s"]), [float(gm["sd"]) * f] * 2 + [0.0, 0.0], n_axes=4)]
         mp = s.get("multipath")
         if mp:
+            if not float(mp.get("tau_s", 0.0)) > 0.0:
+                raise SpecError("multipath.tau_s", f"must be > 0 s, got {mp.get('tau_s')!r}")
+            if not float(mp.get("sd", 0.0)) >= 0.0:
+                raise SpecError("multipath.sd", f"must be >= 0, got {mp.get('sd')!r}")
             parts.append(P.GaussMarkov(float(mp["tau_s"]), [float(mp["sd"]) * f] * 2 + [0.0, 0.0], n_axes=4))
         parts.append(P.WhiteNoise([n, n, vn, vn], n_axes=4))
         if s.get("dropout_p"):
