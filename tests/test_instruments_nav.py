@@ -333,8 +333,8 @@ def _iset(items, seed=5):
 def test_logger_clocks_offset_and_drift():
     """Every instrument stamps its readings with its own logger clock: stamp = t + c + d·t. Same seed,
     clock on vs 'none': identical values (the clock draws from its own stream), stamps differ by exactly
-    c + d·t with the drawn c, d. Over 2400 clocks (12 instruments × 200 trials), the offsets' and drifts' sd are the catalogue's
-    (within 4/√(2·4000)) and the instruments' clocks are independent."""
+    c + d·t with the drawn c, d. Over 2400 clocks (12 instruments × 200 trials), the offsets' and
+    drifts' sd are the catalogue's (within 4/√(2·2400)) and the instruments' clocks are independent."""
     cat = CAT["logger_clock"]
     t = np.arange(0.0, 7200.0, 0.05)
     cols = _track(t, 0.0, 0.0, 5.0, 0.0)
