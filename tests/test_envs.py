@@ -206,7 +206,7 @@ def test_observation_model_matches_instrument_set_statistics():
 
 
 def test_observation_model_gauss_markov_correlation():
-    """Between control instants the slow error decorrelates as exp(−Δ/τ) (GNSS: τ = 120 s)."""
+    """Between control instants the slow error decorrelates as exp(−Δ/τ) (GNSS: τ = 120 s; multipath 10 s)."""
     from vtrials.physics.vessel import load_vessel
     parts, sites, _, _ = suite_parts(load_vessel("patrol51"))
     M, period = 4000, 60.0
@@ -217,7 +217,9 @@ def test_observation_model_gauss_markov_correlation():
     y0 = om.sample(truth)[:, 2].copy()
     y1 = om.sample(truth)[:, 2].copy()
     p = parts["north"]
-    rho_expected = p.gm_sd ** 2 * math.exp(-period / p.gm_tau) / (p.gm_sd ** 2 + p.noise ** 2 + p.resolution ** 2 / 12)
+    # the slow error and the multipath (a second Gauss–Markov error) over white noise and resolution
+    rho_expected = ((p.gm_sd ** 2 * math.exp(-period / p.gm_tau) + p.gm2_sd ** 2 * math.exp(-period / p.gm2_tau))
+                    / (p.gm_sd ** 2 + p.gm2_sd ** 2 + p.noise ** 2 + p.resolution ** 2 / 12))
     rho = np.corrcoef(y0, y1)[0, 1]
     assert abs(rho - rho_expected) < 4 * (1 - rho_expected ** 2) / math.sqrt(M) + 0.01
 

@@ -83,7 +83,7 @@ def test_anemometer_reads_the_motion_of_a_rolling_mast():
              "direction_resolution_deg": 0.0, "airwake_speed": [0.0], "airwake_direction_deg": [0.0],
              "rate_hz": 20.0}
     iset = _run_instruments(v, [{"name": "mast", "spec": "cup_vane_anemometer", "site": "anemometer",
-                                 "set": ideal}], cols)
+                                 "clock": "none", "set": ideal}], cols)  # stamps in true time
     t, ch = iset.readings("mast")
     rs = v.sites["anemometer"]
     om = np.column_stack([cols["p"], cols["q"], cols["r"]])

@@ -9,12 +9,16 @@ samples the same catalogue error parts at the control instants only, for all shi
 with the scale-factor error s and the bias b drawn once per episode, the first-order Gauss–Markov
 error e_GM propagated exactly between control instants (e_{k+1} = a e_k + σ√(1−a²) w, a = exp(−Δ/τ);
 the same discretisation as :class:`vtrials.instruments.parts.GaussMarkov`) and white noise w per
-sample. GNSS drops a fix with the catalogue's probability (the previous fix is held). The part
+sample. GNSS drops a fix with the catalogue's probability (the previous fix is held); its position
+also carries the catalogue's multipath (a second Gauss–Markov error, drawn after the others so the
+other channels' draws are unchanged) and its latency (the fix describes the antenna L seconds earlier:
+position − L·velocity). The part
 values are read from the ship's own suite (catalogue + ``models/<ship>/instruments.toml``) through
 an InstrumentSet, so overrides there apply here too. The gyrocompass adds its speed error less its
 corrector's (settings drawn per episode; :mod:`vtrials.instruments.sensor_errors`). Left out: the
 devices' sampling clocks, the gyrocompass latency (0.1 s; below one control period) and its ballistic
-transients (84-min loop; an episode starts settled), lever-arm terms other than the yaw rate's.
+transients (84-min loop; an episode starts settled), GNSS outages (lost fraction ~0.2 %), lever-arm
+terms other than the yaw rate's.
 
 Each ship draws from its own Generator (seeded per episode), with the episode's white noise drawn
 up front, so a ship's observations do not depend on how many ships run together.
@@ -58,6 +62,9 @@ class ErrorParts:
     corrector_hi: float = 0.0
     corrector_lat_mean: float = 0.0
     corrector_lat_sd: float = 0.0
+    gm2_sd: float = 0.0       # a second Gauss–Markov error (GNSS multipath)
+    gm2_tau: float = 1.0
+    latency: float = 0.0      # [s] the reading describes the measurand this long before its time
 
 
 def _dist(spec: dict, key: str, f: float = 1.0) -> tuple[float, float]:
@@ -116,7 +123,9 @@ def suite_parts(vessel) -> tuple[dict[str, ErrorParts], dict[str, np.ndarray], d
             if ch == "sog":  # velocity noise on each of v_N, v_E (no slow error)
                 parts[ch] = ErrorParts(noise=float(s.get("velocity_noise_mps", 0.0)), dropout_p=base.dropout_p)
             else:
-                parts[ch] = base
+                mp = s.get("multipath") or {"sd": 0.0, "tau_s": 1.0}
+                parts[ch] = dataclasses.replace(base, gm2_sd=float(mp["sd"]) * d.f, gm2_tau=float(mp["tau_s"]),
+                                                latency=float(s.get("latency_s", 0.0)))
         elif ch == "heading" and getattr(d, "north_seeking", False):
             lm, ls = _dist(s, "corrector_latitude_error_deg", DEG)
             parts[ch] = dataclasses.replace(_parts(s, d.f), north_seeking=True, latitude=d.lat, corrector_lo=d.cs_lo,
@@ -146,6 +155,12 @@ class ObservationModel:
         self.a = np.array([math.exp(-self.period / p.gm_tau) for p in P])
         self.b = self.gm_sd * np.sqrt(1.0 - self.a ** 2)
         self.drop_p = parts["north"].dropout_p
+        self.gm2_sd = np.array([p.gm2_sd for p in P])
+        self.a2 = np.array([math.exp(-self.period / p.gm2_tau) for p in P])
+        self.b2 = self.gm2_sd * np.sqrt(1.0 - self.a2 ** 2)
+        self.latency = parts["north"].latency
+        self.gm2 = np.zeros((n, C))
+        self.w2 = np.zeros((n, self.horizon, C))
         self.scale = np.zeros((n, C))
         self.bias = np.zeros((n, C))
         self.gm = np.zeros((n, C))
@@ -168,6 +183,8 @@ class ObservationModel:
         self.w[ship] = rng.standard_normal((self.horizon, 2 * C + 1))
         self.drop[ship] = rng.random(self.horizon) < self.drop_p
         self.drop[ship, 0] = False
+        self.gm2[ship] = self.gm2_sd * rng.standard_normal(C)  # drawn last: the draws above are unchanged
+        self.w2[ship] = rng.standard_normal((self.horizon, C))
         self.k[ship] = 0
         g = self.gyro
         if g.north_seeking:  # drawn last: the other parts keep their draws
@@ -186,6 +203,8 @@ class ObservationModel:
         started = (kk > 0)[:, None]
         gm = np.where(started, self.a * self.gm[idx] + self.b * w[:, C:2 * C], self.gm[idx])
         self.gm[idx] = gm
+        gm2 = np.where(started, self.a2 * self.gm2[idx] + self.b2 * self.w2[idx, k], self.gm2[idx])
+        self.gm2[idx] = gm2
         psi, r = truth["psi"], truth["r"]
         c, s = np.cos(psi), np.sin(psi)
         # sensor positions and velocities (rigid-body yaw lever arms)
@@ -200,13 +219,13 @@ class ObservationModel:
                 np.arcsin(np.clip(self.corr_speed[idx] * c / (SE.EARTH_RADIUS * SE.EARTH_RATE
                                                               * np.cos(self.corr_lat[idx])), -1.0, 1.0)), 0.0)
         m[:, 1] = r
-        m[:, 2] = truth["x"] + c * xg - s * yg
-        m[:, 3] = truth["y"] + s * xg + c * yg
+        m[:, 2] = truth["x"] + c * xg - s * yg - self.latency * vn
+        m[:, 3] = truth["y"] + s * xg + c * yg - self.latency * ve
         m[:, 4] = 0.0
         m[:, 5] = truth["u_r"] - r * self.sites["log_speed"][1]
         m[:, 6] = truth["rudder"]
         m[:, 7] = truth["shaft_rps"]
-        y = m * (1.0 + self.scale[idx]) + self.bias[idx] + gm + self.noise * w[:, :C]
+        y = m * (1.0 + self.scale[idx]) + self.bias[idx] + gm + gm2 + self.noise * w[:, :C]
         sv = self.noise[4]
         y[:, 4] = np.hypot(vn + sv * w[:, 4], ve + sv * w[:, 2 * C])
         nz = self.res > 0

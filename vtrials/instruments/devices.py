@@ -162,10 +162,23 @@ def first_order_lag(t, x, tau, y0, t0):
 
 # ---------------------------------------------------------------------------------------- navigation
 class GNSS(Device):
-    """Satellite positioning at the antenna: north, east (time-correlated errors) and velocity."""
+    """Satellite positioning at the antenna: north, east (time-correlated errors) and velocity.
+
+    Error model (catalogue entries dgps / rtk_gnss), in this order on the receiver's own fixes:
+      * ``gauss_markov``: the slowly varying error of the corrected solution (residual differential /
+        atmospheric error), first-order Gauss–Markov per horizontal axis;
+      * ``multipath``: a second, faster Gauss–Markov process per axis — multipath on a moving ship is a
+        coloured error that decorrelates as the reflection geometry changes (Braasch, "Multipath
+        effects", in Parkinson & Spilker (eds.), GPS: Theory and Applications I, AIAA 1996);
+      * ``noise`` (position) and ``velocity_noise_mps``: white receiver noise;
+      * ``dropout_p``: isolated lost fixes; ``outages``: gaps (Poisson arrivals while up, exponential
+        or fixed lengths, :class:`~vtrials.instruments.parts.Outages`) — the record has no fixes there;
+      * ``latency_s``: the fix arrives, and is time-tagged by the logger, that long after the instant
+        it describes (:class:`~vtrials.instruments.parts.Latency`).
+    """
 
     kind = "gnss"
-    extra_keys = {"velocity_noise_mps"}
+    extra_keys = {"velocity_noise_mps", "multipath", "outages"}
     channels = {"north": ("m", "antenna position north"), "east": ("m", "antenna position east"),
                 "sog": ("m s-1", "speed over ground"), "cog": ("rad", "course over ground (0..2π)")}
     n_axes = 4
@@ -176,10 +189,27 @@ class GNSS(Device):
         n = float(s.get("noise", 0.0)) * f
         vn = float(s.get("velocity_noise_mps", 0.0))
         parts = [P.Resample(float(s["rate_hz"])),
-                 P.GaussMarkov(float(gm["tau_s"]), [float(gm["sd"]) * f] * 2 + [0.0, 0.0], n_axes=4),
-                 P.WhiteNoise([n, n, vn, vn], n_axes=4)]
+                 P.GaussMarkov(float(gm["tau_s"]), [float(gm["sd"]) * f] * 2 + [0.0, 0.0], n_axes=4)]
+        mp = s.get("multipath")
+        if mp:
+            if not float(mp.get("tau_s", 0.0)) > 0.0:
+                raise SpecError("multipath.tau_s", f"must be > 0 s, got {mp.get('tau_s')!r}")
+            if not float(mp.get("sd", 0.0)) >= 0.0:
+                raise SpecError("multipath.sd", f"must be >= 0, got {mp.get('sd')!r}")
+            parts.append(P.GaussMarkov(float(mp["tau_s"]), [float(mp["sd"]) * f] * 2 + [0.0, 0.0], n_axes=4))
+        parts.append(P.WhiteNoise([n, n, vn, vn], n_axes=4))
         if s.get("dropout_p"):
             parts.append(P.Dropouts(p=float(s["dropout_p"])))
+        out = s.get("outages")
+        if out and float(out.get("rate_per_h", 0.0)) > 0.0:
+            dur = out.get("durations", "exponential")
+            if dur not in ("exponential", "fixed"):
+                raise SpecError("outages.durations", f"{dur!r} unknown (allowed: exponential, fixed)")
+            if not float(out.get("duration_s", 0.0)) > 0.0:
+                raise SpecError("outages.duration_s", f"must be > 0 s, got {out.get('duration_s')!r}")
+            parts.append(P.Outages(float(out["rate_per_h"]) / 3600.0, float(out["duration_s"]), dur))
+        if s.get("latency_s"):
+            parts.append(P.Latency(float(s["latency_s"])))
         self.chain = P.Chain(parts)
 
     def measurand(self, kin, cols):
@@ -190,6 +220,11 @@ class GNSS(Device):
     def outputs(self, t, y):
         return {"north": y[:, 0], "east": y[:, 1], "sog": np.hypot(y[:, 2], y[:, 3]),
                 "cog": _wrap2pi(np.arctan2(y[:, 3], y[:, 2]))}
+
+
+def _survey_errors(rng: np.random.Generator, sd: float, n: int) -> np.ndarray:
+    """(n, 2) north/east errors [m] of n surveyed shore/bottom stations, N(0, sd²) per axis."""
+    return sd * rng.standard_normal((n, 2))
 
 
 def two_range_fix(r1, r2, a, b, side: float):
@@ -210,9 +245,17 @@ def two_range_fix(r1, r2, a, b, side: float):
 class RangeRadar(Device):
     """Range–range pulse radar (Falcon, seed 002): ranges from the ship's antenna to two shore
     transponders, and the position fix the system computes from them and the surveyed baseline.
-    The fix error grows as the range lines' crossing angle narrows (geometric dilution)."""
+    The fix error grows as the range lines' crossing angle narrows (geometric dilution).
+
+    Range errors (catalogue entry falcon_radar), per transponder: ``bias`` — the transponder's reply
+    delay not taken out by the calibration, drawn per trial; ``gauss_markov`` — multipath (range
+    reflections, seed 002), a time-correlated error; ``noise`` — white. ``survey_sd_m``: the shore
+    stations actually stand N(0, sd²) per axis away from their surveyed positions (drawn per trial);
+    the ranges are to the actual stations, the fix uses the surveyed ones, so the survey error maps
+    through the two-range geometry into a position bias that changes slowly along the track."""
 
     kind = "range_radar"
+    extra_keys = {"survey_sd_m"}
     channels = {"range_a": ("m", "range to transponder A"), "range_b": ("m", "range to transponder B"),
                 "north": ("m", "position fix north"), "east": ("m", "position fix east"),
                 "crossing_angle": ("rad", "angle between the two range lines at the fix")}
@@ -226,11 +269,21 @@ class RangeRadar(Device):
                                             "site ([site] transponders = [[north, east], [north, east]])")
         self.a, self.b = np.array(tr[0], float), np.array(tr[1], float)
         self.side = float(site.get("transponder_side", 1.0))
+        self.survey_sd = float(self.spec.get("survey_sd_m", 0.0))
+        if not (math.isfinite(self.survey_sd) and self.survey_sd >= 0.0):
+            raise SpecError("survey_sd_m", f"must be finite and >= 0, got {self.spec.get('survey_sd_m')!r}")
         self.chain = value_chain(self.spec, self.f, 2)
+        self.survey_error = np.zeros((2, 2))
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        self.chain.reset(r1)
+        self.survey_error = _survey_errors(r2, self.survey_sd, 2)
 
     def measurand(self, kin, cols):
         p = kin.position()[:, :2]
-        return np.column_stack([np.linalg.norm(p - self.a, axis=1), np.linalg.norm(p - self.b, axis=1)])
+        a_true, b_true = self.a + self.survey_error[0], self.b + self.survey_error[1]
+        return np.column_stack([np.linalg.norm(p - a_true, axis=1), np.linalg.norm(p - b_true, axis=1)])
 
     def outputs(self, t, y):
         n, e = two_range_fix(y[:, 0], y[:, 1], self.a, self.b, self.side)
@@ -240,17 +293,24 @@ class RangeRadar(Device):
         return {"range_a": y[:, 0], "range_b": y[:, 1], "north": n, "east": e,
                 "crossing_angle": np.arccos(np.clip(cosg, -1, 1))}
 
+    def drawn(self):
+        return {"survey_error_m": self.survey_error.tolist(), "chain": self.chain.drawn()}
+
     def meta(self):
         m = super().meta()
-        m.update({"transponder_a": self.a.tolist(), "transponder_b": self.b.tolist(), "fix_side": self.side})
+        m.update({"transponder_a": self.a.tolist(), "transponder_b": self.b.tolist(), "fix_side": self.side,
+                  "station_survey_sd_m": self.survey_sd})
         return m
 
 
 class AcousticRange(Device):
     """Acoustic range: a pinger on the hull every 1–4 s, slant ranges to hydrophones on the bottom
-    (seed 002); the fix is the least-squares intersection of the horizontal ranges."""
+    (seed 002); the fix is the least-squares intersection of the horizontal ranges. As for the radar,
+    ``survey_sd_m`` draws per trial how far each hydrophone actually lies from its surveyed position
+    (the ranges are to the actual positions, the fix uses the surveyed ones)."""
 
     kind = "acoustic_range"
+    extra_keys = {"survey_sd_m"}
     channels = {"north": ("m", "position fix north"), "east": ("m", "position fix east")}
 
     def build(self):
@@ -265,13 +325,23 @@ class AcousticRange(Device):
         a, b = self.spec.get("update_s", [1.0, 4.0])
         self.n_axes = len(self.h)
         parts = [P.IrregularUpdates(float(a), float(b), method="linear")]
-        self.chain = value_chain({k: v for k, v in self.spec.items() if k != "rate_hz"}, self.f, self.n_axes,
-                                 sampling=parts)
+        self.survey_sd = float(self.spec.get("survey_sd_m", 0.0))
+        if not (math.isfinite(self.survey_sd) and self.survey_sd >= 0.0):
+            raise SpecError("survey_sd_m", f"must be finite and >= 0, got {self.spec.get('survey_sd_m')!r}")
+        self.chain = value_chain({k: v for k, v in self.spec.items() if k not in ("rate_hz", "survey_sd_m")},
+                                 self.f, self.n_axes, sampling=parts)
+        self.survey_error = np.zeros((len(self.h), 2))
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        self.chain.reset(r1)
+        self.survey_error = _survey_errors(r2, self.survey_sd, len(self.h))
 
     def measurand(self, kin, cols):
         p = kin.position()
         dz = self.depth - p[:, 2]
-        return np.column_stack([np.sqrt(np.sum((p[:, :2] - hp) ** 2, axis=1) + dz ** 2) for hp in self.h])
+        h_true = self.h + self.survey_error
+        return np.column_stack([np.sqrt(np.sum((p[:, :2] - hp) ** 2, axis=1) + dz ** 2) for hp in h_true])
 
     def outputs(self, t, y):
         # horizontal ranges from slant ranges (the pinger's depth is known), then the two-station fix
@@ -280,9 +350,13 @@ class AcousticRange(Device):
         n, e = two_range_fix(r[:, 0], r[:, 1], self.h[0], self.h[1], self.side)
         return {"north": n, "east": e}
 
+    def drawn(self):
+        return {"survey_error_m": self.survey_error.tolist(), "chain": self.chain.drawn()}
+
     def meta(self):
         m = super().meta()
-        m.update({"hydrophones": self.h.tolist(), "hydrophone_depth_m": self.depth})
+        m.update({"hydrophones": self.h.tolist(), "hydrophone_depth_m": self.depth,
+                  "station_survey_sd_m": self.survey_sd})
         return m
 
 

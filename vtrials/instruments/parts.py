@@ -67,7 +67,7 @@ import numpy as np
 __all__ = [
     "Part", "Chain", "Bias", "ScaleFactor", "Misalignment", "WhiteNoise", "GaussMarkov", "RandomWalk",
     "Quantization", "Resolution", "Saturation", "Latency", "SampleHold", "IrregularUpdates",
-    "WindowAverage", "AverageBetweenUpdates", "Dropouts", "ClockOffset", "Resample",
+    "WindowAverage", "AverageBetweenUpdates", "Dropouts", "ClockOffset", "Resample", "Outages",
 ]
 
 _METHODS = ("linear", "previous")
@@ -1046,3 +1046,94 @@ class Dropouts(Part):
     def _drawn(self):
         return {"p": self.p, "outage_rate_per_s": self.outage_rate, "outage_mean_s": self.outage_mean,
                 "initially_down": self.initially_down}
+
+
+class Outages(Part):
+    """Signal outages: gaps in the output whose starts are Poisson arrivals and whose lengths are
+    exponential or fixed — e.g. GNSS fixes lost while masts or superstructure shadow the antenna or the
+    differential corrections drop out. Samples inside an outage are removed (not NaN).
+
+    An alternating renewal process (Cox, Renewal Theory, 1962): up periods ~Exp(mean 1/``rate``)
+    (so outages begin at ``rate`` [1/s] while the signal is up), down periods of length ``duration``
+    [s], ``durations="exponential"`` (mean ``duration``) or ``"fixed"``. Long-run lost fraction
+    D/(U + D), U = 1/rate, D = ``duration``; outages begin at 1/(U + D) per unit time overall. Started
+    in its stationary state at the first input sample: down with probability D/(U + D), and then the
+    rest of that outage is the forward recurrence time of the down period (Exp(D) for exponential,
+    U(0, D) for fixed lengths); otherwise the rest of the up period is Exp(U) (memoryless). One
+    standard-uniform or standard-exponential draw per switch, in order, from the part's own stream
+    (streaming-invariant). ``outages()`` lists the (start, end) of the outages generated so far.
+    """
+
+    def __init__(self, rate: float, duration: float, durations: str = "exponential"):
+        _nonneg("Outages", rate=rate)
+        _positive("Outages", duration=duration)
+        if durations not in ("exponential", "fixed"):
+            raise ValueError(f"Outages: durations must be 'exponential' or 'fixed', got {durations!r}")
+        self.rate, self.duration, self.durations = float(rate), float(duration), durations
+        self.initially_down = None
+
+    def _reset(self, rng):
+        self._rng = rng
+        self._sw: list[float] = []     # pending switch times (> latest input time), ascending
+        self._down = None              # state at the latest input time (before the pending switches)
+        self._gen_down = None          # state after the last generated switch
+        self._last_sw = None
+        self._log: list[float] = []    # every switch time generated (for outages())
+        self.initially_down = None
+
+    def _down_length(self) -> float:
+        if self.durations == "fixed":
+            return self.duration
+        return self.duration * float(self._rng.standard_exponential())
+
+    def _generate(self, end: float) -> None:
+        while self._last_sw <= end:
+            if self._gen_down:           # now down: the outage ends after its length
+                step = self._down_length()
+            else:                        # now up: the next outage starts after Exp(1/rate)
+                step = float(self._rng.standard_exponential()) / self.rate
+            self._last_sw += step
+            self._sw.append(self._last_sw)
+            self._log.append(self._last_sw)
+            self._gen_down = not self._gen_down
+
+    def _process(self, t, x):
+        if t.size == 0 or self.rate == 0.0:
+            return t, x.copy()
+        if self._down is None:
+            u, d = 1.0 / self.rate, self.duration
+            self._down = bool(self._rng.random() < d / (u + d))
+            self.initially_down = self._down
+            self._gen_down = self._down
+            if self._down:   # the rest of the outage in progress (forward recurrence time)
+                rest = d * float(self._rng.random()) if self.durations == "fixed" else self._down_length()
+            else:
+                rest = float(self._rng.standard_exponential()) / self.rate
+            self._t0 = float(t[0])
+            self._last_sw = float(t[0]) + rest
+            self._sw = [self._last_sw]
+            self._log = [self._last_sw]
+            self._gen_down = not self._gen_down
+        self._generate(float(t[-1]))
+        sw = np.array(self._sw)
+        idx = np.searchsorted(sw, t, side="right")
+        down = np.logical_xor(self._down, idx % 2 == 1)
+        m = int(np.searchsorted(sw, t[-1], side="right"))
+        self._down = bool(self._down ^ (m % 2 == 1))
+        self._sw = self._sw[m:]
+        return t[~down], x[~down]
+
+    def outages(self) -> list[tuple[float, float]]:
+        """(start, end) [s] of the outages generated so far (an outage in progress at the first sample
+        starts there; the last may end after the latest input)."""
+        if self.initially_down is None:
+            return []
+        sw = list(self._log)
+        if self.initially_down:
+            sw = [self._t0] + sw
+        return [(sw[i], sw[i + 1]) for i in range(0, len(sw) - 1, 2)]
+
+    def _drawn(self):
+        return {"rate_per_s": self.rate, "duration_s": self.duration, "durations": self.durations,
+                "initially_down": self.initially_down,
+                "outages_s": [list(o) for o in self.outages()]}

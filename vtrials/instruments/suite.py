@@ -10,6 +10,8 @@ Suite file ``models/<ship>/instruments.toml``::
     shaft = "port"             # shaft instruments: which shaft
     rudder = "port"            # rudder synchro: which rudder
     full_scale = 1.0e5         # instruments whose errors are % of full scale
+    clock = "logger_clock"     # optional: the clock entry of the catalogue that time-stamps its
+                               # readings (default logger_clock; "none": stamps in true time)
     [instrument.set]           # optional: override catalogue values (same keys and units)
     noise = 0.05
 
@@ -17,6 +19,13 @@ A scenario may list ``[[instrument]]`` tables too: one with a suite name overrid
 a new name adds an instrument. Every instrument draws from its own random stream, spawned from
 the scenario seed and keyed by its name (numpy SeedSequence), so streams are independent and do
 not depend on the order or number of instruments.
+
+Clocks: each instrument's readings are time-stamped by its own logger clock (a ``kind = "clock"``
+entry of the catalogue, ``logger_clock`` unless the entry names another or ``"none"``):
+stamp = t + c + d·t with the offset c ~ N(0, offset_s²) and the drift d ~ N(0, drift_ppm²)·10⁻⁶
+drawn per instrument per trial (:class:`vtrials.instruments.parts.ClockOffset`, t_ref = 0, the start
+of the recording, when the loggers were synchronised), from a stream of its own (spawn-key namespace
+``CLOCK_KEY``), so the clock leaves the instrument's other draws unchanged.
 """
 
 from __future__ import annotations
@@ -31,9 +40,12 @@ import numpy as np
 from vtrials.errors import InputError
 from vtrials.schema import did_you_mean, check_name, check_value, load_toml, num, read_table, table, text, unknown_key, Spec
 from vtrials.instruments.devices import KINDS, RudderAngle, ShaftDevice, SpecError
+from vtrials.instruments.parts import ClockOffset
 
 CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
 SEED_KEY = 4  # spawn-key namespace of instrument streams
+CLOCK_KEY = 5  # spawn-key namespace of the instruments' logger clocks
+DEFAULT_CLOCK = "logger_clock"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,6 +57,7 @@ class Entry:
     rudder: str = text("rudder measured (rudder synchro)", default=None)
     full_scale: float = num("full scale of the instrument (for % FS errors)", "", 0.0, 1e12, lo_open=True,
                             default=None)
+    clock: str = text("catalogue clock entry that stamps the readings ('none': true time)", default=None)
 
 
 def load_catalogue(path: Path = CATALOGUE) -> dict:
@@ -162,15 +175,17 @@ class InstrumentSet:
             if e.name in merged:
                 base, bsets, _, _ = merged[e.name]
                 fields = {k: getattr(e, k) if getattr(e, k) is not None else getattr(base, k)
-                          for k in ("name", "spec", "site", "shaft", "rudder", "full_scale")}
+                          for k in ("name", "spec", "site", "shaft", "rudder", "full_scale", "clock")}
                 merged[e.name] = (Entry(**fields), {**bsets, **sets}, scenario_file, where)
             else:
                 merged[e.name] = (e, sets, scenario_file, where)
         self.team = self._team(site_info)
         self.devices = {}
+        self.clocks: dict[str, ClockOffset | None] = {}
         for name in sorted(merged):
             e, sets, f, where = merged[name]
             self.devices[name] = self._build(e, sets, cat, f, where)
+            self.clocks[name] = self._clock(e, cat, f, where)
         self.seed = seed
         self.stream = tuple(stream)
         self._out: dict[str, list] = {}
@@ -192,6 +207,26 @@ class InstrumentSet:
                                "angles_rad": ang.tolist(), "C_X": np.asarray(cx).tolist(),
                                "C_Y": np.asarray(cy).tolist(), "C_N": np.asarray(cn).tolist()}
         return team
+
+    @staticmethod
+    def _clock(e: Entry, cat: dict, f: str, where: str) -> ClockOffset | None:
+        """The logger clock of one instrument, from its catalogue clock entry."""
+        name = e.clock if e.clock is not None else DEFAULT_CLOCK
+        if name == "none":
+            return None
+        clocks = [k for k, v in cat.items() if isinstance(v, dict) and v.get("kind") == "clock"]
+        if name not in clocks:
+            raise InputError(f, f"{where}.clock", f"{name!r} is not a clock of the catalogue{did_you_mean(name, clocks)} "
+                                                  f"(clocks: {', '.join(clocks)}, or 'none')")
+        spec = cat[name]
+        vals = {}
+        for key in ("offset_s", "drift_ppm"):
+            v = spec.get(key)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (v >= 0.0 and v < 1e6):
+                raise InputError(str(CATALOGUE), f"{name}.{key}", f"expected a standard deviation >= 0 "
+                                                                  f"(and < 1e6), got {v!r}")
+            vals[key] = float(v)
+        return ClockOffset(sd=vals["offset_s"], drift_ppm_sd=vals["drift_ppm"])
 
     def _build(self, e: Entry, sets: dict, cat: dict, f: str, where: str):
         v = self.vessel
@@ -244,6 +279,10 @@ class InstrumentSet:
         for name, dev in self.devices.items():
             ss = np.random.SeedSequence(self.seed, spawn_key=(SEED_KEY, *self.stream, zlib.crc32(name.encode())))
             dev.reset(np.random.Generator(np.random.PCG64(ss)))
+            clk = self.clocks.get(name)
+            if clk is not None:
+                cs = np.random.SeedSequence(self.seed, spawn_key=(CLOCK_KEY, *self.stream, zlib.crc32(name.encode())))
+                clk.reset(np.random.Generator(np.random.PCG64(cs)))
         self._out = {name: [] for name in self.devices}
         self._pending: list[dict] = []  # queued truth chunks, consolidated into one at each flush
         self._seen = {name: 0 for name in self.devices}  # rows of the consolidated chunk each device has seen
@@ -275,6 +314,9 @@ class InstrumentSet:
                 continue
             part = cols if k == 0 else {c: v[k:] for c, v in cols.items()}
             t, ch = self.devices[name].process(part)
+            clk = self.clocks.get(name)
+            if clk is not None and t.size:  # the logger's stamp: t + c + d·(t − t_ref), as ClockOffset
+                t = t + clk.offset + (clk.drift_ppm * 1e-6) * (t - clk.t_ref)
             if t.size:
                 self._out[name].append((t, ch))
             self._seen[name] = n
@@ -317,7 +359,12 @@ class InstrumentSet:
         return [n for n, d in self.devices.items() if d.kind == kind]
 
     def drawn(self) -> dict:
-        return {name: dev.drawn() for name, dev in self.devices.items()}
+        out = {}
+        for name, dev in self.devices.items():
+            d = dev.drawn()
+            clk = self.clocks.get(name)
+            out[name] = {**d, "logger_clock": clk.drawn()} if clk is not None else d
+        return out
 
     def meta(self) -> dict:
         return {name: dev.meta() for name, dev in self.devices.items()}
