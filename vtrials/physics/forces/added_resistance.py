@@ -22,7 +22,8 @@ Fn = U/√(gL), λ = 2π/k the wavelength, c = ω/k the phase speed. Regular wav
   following seas (α = 0) by the ship's speed against the wave's phase speed: U = 0 the formula at
   α = 0 (a₁ < 0: the waves push the ship along); U = c/4 a₁ = 0, a₂ = a₂(Fn); U = c/2 the head-sea
   a₁ (cos α = −1) at Fn = 0, a₂ = 0.0072; U > c/2 head-sea a₁, a₂ at Fn' = (U − c/2)/√(gL); linear
-  in U between these points; for 0 < α < π/2 a₁, a₂ linear in α between α = π/2 and α = 0;
+  in U between these points; for 0 < α < π/2 a₁, a₂ linear in α between α = π/2 and α = 0; where
+  ω̄ ≤ 0 (Fn ≳ 1.2, far outside the regression) the motion part is taken as zero;
 * reflection (diffraction) part, per unit ζ²: R_AWR = ρ g (2.25/4) B α_T Σ s_i, with
       s₁ = [sin²(E₁ − α) + (2ωU/g)(cos E₁ cos(E₁ − α) − cos α)] (0.87/C_B)^{(1+4√Fn) f(α)}   (E₁ ≤ α ≤ π),
       s₂ = [sin²(E₁ + α) + (2ωU/g)(cos E₁ cos(E₁ + α) − cos α)] (0.87/C_B)^{(1+4√Fn) f(α)}   (π − E₁ ≤ α ≤ π),
@@ -218,13 +219,19 @@ def raw_regular(h, omega, k, alpha, U):
     wbar = (2.142 * kyy ** (1.0 / 3.0) * math.sqrt(Lpp / lam) * (1.0 - 0.111 / cb * (ln_bt - math.log(2.75)))
             * (cb / 0.65) ** 0.17 * ((-1.377 * fn * fn + 1.157 * fn) * abs(cos_a)
                                      + 0.618 * (13.0 + math.cos(2.0 * alpha)) / 14.0))
-    if wbar < 1.0:
+    if wbar <= 0.0:          # far beyond the regression's speeds (Fn ≳ 1.2): no motion part
+        wbar = 0.0
+        b1 = 11.0
+        d1 = 1.0
+    elif wbar < 1.0:
         b1 = 11.0
         d1 = 566.0 * (Lpp * cb / B) ** (-2.66)
     else:
         b1 = -8.5
         d1 = -566.0 * (Lpp / B) ** (-2.66) * (4.0 - 125.0 * trim)
-    r_m = 4.0 * rho * g * B * B / Lpp * wbar ** b1 * math.exp(b1 / d1 * (1.0 - wbar ** d1)) * a1 * a2 * a3
+    r_m = 0.0
+    if wbar > 0.0:
+        r_m = 4.0 * rho * g * B * B / Lpp * wbar ** b1 * math.exp(b1 / d1 * (1.0 - wbar ** d1)) * a1 * a2 * a3
     # reflection part
     two_wug = 2.0 * omega * U / g
     f = -cos_a if alpha >= math.pi - E1 else 0.0
@@ -255,11 +262,16 @@ def regular(hull: SNNMHull, omega, alpha, U, k=None) -> np.ndarray:
     omega, alpha, U = np.broadcast_arrays(np.asarray(omega, float), np.asarray(alpha, float), np.asarray(U, float))
     k = omega ** 2 / hull.g if k is None else np.broadcast_to(np.asarray(k, float), omega.shape)
     a = np.abs(np.remainder(alpha + np.pi, 2.0 * np.pi) - np.pi)
-    h = hull.header()
     out = np.empty(omega.shape)
-    for idx in np.ndindex(omega.shape):
-        out[idx] = raw_regular(h, float(omega[idx]), float(k[idx]), float(a[idx]), float(U[idx]))
+    _regular_many(hull.header(), np.ascontiguousarray(omega).ravel(), np.ascontiguousarray(k).ravel(),
+                  np.ascontiguousarray(a).ravel(), np.ascontiguousarray(U).ravel(), out.reshape(-1))
     return out
+
+
+@nb.njit(cache=True)
+def _regular_many(h, omega, k, a, U, out):
+    for i in range(omega.size):
+        out[i] = raw_regular(h, omega[i], k[i], a[i], U[i])
 
 
 @nb.njit(cache=True, fastmath=False)
