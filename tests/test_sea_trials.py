@@ -153,3 +153,43 @@ def test_stawave_corrected_reduction_recovers_the_calm_water_curve(sea_day):
             assert abs(cor) < abs(raw)
     print(f"worst |error| uncorrected {worst_raw:.2%}, STAWAVE-2 corrected {worst_cor:.2%}")
     assert worst_cor <= 0.025
+
+
+def test_side_by_side_runner_builds_the_ships_in_the_sea(tmp_path):
+    """Two turning circles in the State 3 sea through the side-by-side runner: the ships pitch and heave
+    (five times more than in the same scenario without waves, where only the turn trims the ship) and
+    both turns complete."""
+    res = vtrials.run(DATA / "patrol51_turns_sea3.toml", tmp_path / "sea", plot=False)
+    text = (DATA / "patrol51_turns_sea3.toml").read_text()
+    start = text.index("[environment.waves]")
+    calm_file = tmp_path / "calm.toml"
+    calm_file.write_text(text[:start] + text[text.index("[[maneuver]]"):])
+    calm = vtrials.run(calm_file, tmp_path / "calm", plot=False)
+    for m_sea, m_calm in zip(res.maneuvers, calm.maneuvers):
+        ps, pc = np.std(m_sea.columns["pitch"]), np.std(m_calm.columns["pitch"])
+        print(f"{m_sea.name}: completed {m_sea.completed}, pitch RMS sea {ps:.4f} calm {pc:.5f} rad, "
+              f"tactical diameter sea {m_sea.truth.get('tactical_diameter_m')}, calm {m_calm.truth.get('tactical_diameter_m')}")
+        assert m_sea.completed and m_calm.completed
+        assert ps > 0.004 and ps > 5.0 * pc
+        assert np.all(np.isfinite(m_sea.columns["x"]))
+
+
+@pytest.mark.parametrize("value,ok", [("snnm", True), ("database", True), ("none", True), ("stawave", False)])
+def test_wave_loads_choice(tmp_path, value, ok):
+    text = SHORT.read_text().replace("[environment.waves]", f'[environment.wave_loads]\nmean_force = "{value}"\n\n'
+                                                              "[environment.waves]")
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    from vtrials.errors import InputError
+    from vtrials.scenario import sea_vessel
+    if not ok:
+        with pytest.raises(InputError) as e:
+            load_scenario(f)
+        assert "environment.wave_loads.mean_force" in str(e.value) and "stawave" in str(e.value)
+        return
+    scn = load_scenario(f)
+    assert scn.wave_loads.mean_force == value
+    names = [c.name for c in sea_vessel(scn)[0].components]
+    assert "seakeeping_coriolis" in names                 # patrol51: added_mass.coriolis = "none"
+    assert ("added_resistance" in names) == (value == "snnm")
+    assert ("wave_drift" in names) == (value in ("snnm", "database"))
