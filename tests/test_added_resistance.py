@@ -11,11 +11,11 @@ following, zero speed) equals, within 10 % (issue 10), the spectral integral of 
   seas with the full seakeeping model (:func:`vtrials.physics.seakeeping.sea_ship.sea_ship`, mean force
   "snnm") loses, within 10 %, the speed that the force balance with the added resistance alone predicts
   (steady_at_order of the calm-water ship carrying only the SNNM component, which depends on the speed).
-* Regular-wave checks of the formula's structure: zero speed head and following seas are equal and
-  opposite in long waves where only the motion part acts (a₁ at α = 0 and π differ only by the sign of
-  (1 − 2 cos α)/3 = −1/3 and 1 and the (0.87/C_B) exponent), the reflection part in short head waves
-  tends to (2.25/4) ρ g B [sin²(E₁ − π) + sin²(E₁ + π)] (0.87/C_B)^{(1+4√Fn)} (1 + 2ωU/g-type speed
-  factor) as α_T → 1.
+* Regular-wave checks of the formula's structure: at zero speed in long waves (λ > 2.5 L: no
+  reflection part) following over head seas is −(1/3)(0.87/C_B)^{−2} (a₁'s factors (1 − 2 cos α)/3 and
+  (0.87/C_B)^{−cos α} at α = 0 and π; the waves push the ship along from astern); in very short head
+  waves the motion part vanishes and the reflection part is (2.25/4) ρ g B α_T [sin²(E₁ − π) + sin²(E₁ + π)
+  + 2 (2ωU/g)(cos E₁ cos(E₁ + π) + 1)] (0.87/C_B)^{1+4√Fn} (written out independently in the test).
 """
 
 from __future__ import annotations
