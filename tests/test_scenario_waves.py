@@ -1,8 +1,8 @@
 """[environment.waves] in scenarios: parsing, the seeded realization and the ship in the sea.
 
-The State 3 standardization day (scenarios/seakeeping/patrol51_standardization_sea3.toml) is not yet
-under scenarios/ (so not pinned nor run by the CLI tests): the runners do not yet build their
-simulator from :func:`vtrials.scenario.sea_vessel` (see the report).
+The State 3 standardization day (scenarios/patrol51_standardization_sea3.toml) is a shipped scenario:
+the runners build their simulator from :func:`vtrials.scenario.sea_vessel` (end to end:
+tests/test_sea_trials.py).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from vtrials.physics import steering as H
 from vtrials.scenario import environment_block, load_scenario, sea_vessel, wave_field
 
 ROOT = Path(__file__).resolve().parents[1]
-SEA3 = ROOT / "scenarios" / "seakeeping" / "patrol51_standardization_sea3.toml"
+SEA3 = ROOT / "scenarios" / "patrol51_standardization_sea3.toml"
 CALM = ROOT / "scenarios" / "patrol51_standardization.toml"
 
 

@@ -7,7 +7,8 @@ every field):
 ``[initial]``       exactly one of froude_number / speed_kn / speed_mps; heading_deg; propulsion
 ``[environment]``   water_depth_m; ``[environment.current]`` (see :class:`vtrials.physics.environment.current.Current`);
                     ``[environment.waves]`` (:class:`vtrials.physics.environment.waves.Waves`; a seaway realized
-                    from the scenario seed, see :func:`wave_field` and :func:`sea_vessel`)
+                    from the scenario seed, see :func:`wave_field` and :func:`sea_vessel`);
+                    ``[environment.wave_loads]`` (:class:`WaveLoads`: the mean wave force's method)
 ``[[maneuver]]``    one table per maneuver, with ``kind`` and that kind's fields
                     (:mod:`vtrials.trials.programs`), run side by side, one ship each
 ``[agenda]``        instead of maneuvers: a trial agenda executed run by run on one ship by the virtual
@@ -70,6 +71,16 @@ class Environment:
                                lo_open=True, default=10000.0)
 
 
+@dataclasses.dataclass(frozen=True)
+class WaveLoads:
+    """How the ship's wave loads are modelled (``[environment.wave_loads]``; used only with waves)."""
+
+    mean_force: str = text("mean second-order wave force: 'snnm' (surge: SNNM added resistance at the ship's "
+                           "speed and heading, Liu & Papanikolaou 2020; sway, yaw: the database's drift), "
+                           "'database' (the BEM database's zero-speed drift in surge, sway and yaw) or 'none'",
+                           ("snnm", "database", "none"), default="snnm")
+
+
 MAX_GRADIENT_CURRENT_KN = 10.0  # the steady current's own bound (Current.speed_kn)
 SITE_EXTENT_M = 100000.0  # every surveyed point lies within 100 km of the range's origin (a trial area)
 
@@ -127,6 +138,7 @@ class Scenario:
     instrument_items: list = dataclasses.field(default_factory=list)
     agenda: object = None  # vtrials.trials.agenda.Agenda when the scenario is an agenda
     waves: Waves = dataclasses.field(default_factory=Waves)  # calm unless [environment.waves] says so
+    wave_loads: WaveLoads = dataclasses.field(default_factory=WaveLoads)
 
     @property
     def speed(self) -> float:
@@ -179,6 +191,7 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     cur_tab = table(env_tab.pop("current", None), f, "environment.current")
     wind_tab = table(env_tab.pop("wind", None), f, "environment.wind")
     waves_tab = table(env_tab.pop("waves", None), f, "environment.waves")
+    loads_tab = table(env_tab.pop("wave_loads", None), f, "environment.wave_loads")
     env, _ = read_table(Environment, env_tab, f, "environment")
     if env.water_depth_m <= vessel.particulars.draught:
         raise InputError(f, "environment.water_depth_m", f"{env.water_depth_m} m does not float the ship "
@@ -194,6 +207,7 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
         raise InputError(f, "environment.wind.speed_kn", f"{vessel.name} has no [windage] data for wind loads")
     waves, _ = read_table(Waves, waves_tab, f, "environment.waves")
     waves.check(f)
+    wave_loads, _ = read_table(WaveLoads, loads_tab, f, "environment.wave_loads")
     if (waves.hs_m > 0.0 or waves.swell_hs_m > 0.0) and not _hydro_path(vessel).is_file():
         raise InputError(f, "environment.waves", f"{vessel.name} has no hydrodynamic database "
                          f"({_hydro_path(vessel)}) for wave loads")
@@ -253,7 +267,8 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
         from vtrials.trials.agenda import load_agenda
         agenda = load_agenda(table(doc["agenda"], f, "agenda"), vessel, f)
     instruments = table_list(doc.get("instrument", []), f, "instrument")
-    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda, waves=waves)
+    scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda, waves=waves,
+                   wave_loads=wave_loads)
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
     from vtrials.instruments.suite import InstrumentSet
     InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
@@ -296,7 +311,8 @@ def wave_field(scn: Scenario):
 
 def sea_vessel(scn: Scenario, dt: float | None = None, model=None):
     """The scenario's ship with the seakeeping force components for its seaway (the calm-water
-    ``scn.vessel`` itself in a calm sea), for a simulator with step ``dt`` (default: the scenario's).
+    ``scn.vessel`` itself in a calm sea), for a simulator with step ``dt`` (default: the scenario's):
+    :func:`vtrials.physics.seakeeping.sea_ship.sea_ship` with ``[environment.wave_loads] mean_force``.
 
     Components outside the database's frequency range [ω_min/2, ω_max] are left out (their share of
     the sea's variance is returned with the vessel as ``(vessel, dropped_variance_fraction)``).
@@ -306,11 +322,12 @@ def sea_vessel(scn: Scenario, dt: float | None = None, model=None):
     if field is None:
         return scn.vessel, 0.0
     from vtrials.physics.seakeeping.database import load_database
-    from vtrials.physics.seakeeping.timedomain import seakeeping_vessel
+    from vtrials.physics.seakeeping.sea_ship import sea_ship
     db = load_database(_hydro_path(scn.vessel))
     comp = field.components
     keep = (comp[:, 1] >= 0.5 * db.omega[0]) & (comp[:, 1] <= db.omega[-1])
     var = float(np.sum(comp[:, 0] ** 2))
     dropped = float(np.sum(comp[~keep, 0] ** 2)) / var if var > 0.0 else 0.0
-    v, _ = seakeeping_vessel(scn.vessel, db, comp[keep], scn.head.timestep_s if dt is None else dt, model=model)
+    v, _ = sea_ship(scn.vessel, db, comp[keep], scn.head.timestep_s if dt is None else dt, model=model,
+                    mean_force=scn.wave_loads.mean_force)
     return v, dropped

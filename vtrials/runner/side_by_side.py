@@ -27,7 +27,7 @@ from vtrials.trials.driver import Driver
 from vtrials.trials.programs import ProgramSupervisor
 from vtrials.records.netcdf import atomic_path, write_groups
 from vtrials.runner.outputs import json_clean
-from vtrials.scenario import Scenario, environment_block
+from vtrials.scenario import Scenario, environment_block, sea_vessel
 from vtrials.instruments.suite import InstrumentSet
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.records.trial import write_record
@@ -139,10 +139,16 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
     vessel = scn.vessel
     N = len(scn.maneuvers)
     dt = scn.head.timestep_s
-    sim = Simulator(vessel, N, dt, environment_block(scn), nthread=nthread, record_every=scn.head.record_every,
+    env = environment_block(scn)
+    # in a seaway the ships carry the wave components (vtrials.scenario.sea_vessel); the approaches are
+    # the calm-water steady conditions (found on the calm-water ship: a steady search in the sea would
+    # balance one instant's wave excitation), from which the ships settle during the approach
+    ship, _dropped = sea_vessel(scn, dt)
+    sim = Simulator(ship, N, dt, env, nthread=nthread, record_every=scn.head.record_every,
                     planar=scn.head.planar)
+    calm = sim if ship is vessel else Simulator(vessel, N, dt, env, record_every=0, planar=scn.head.planar)
     ap = _autopilot_args(scn)
-    starts = [_approach(sim, i, scn, m) for i, m in enumerate(scn.maneuvers)]
+    starts = [_approach(calm, i, scn, m) for i, m in enumerate(scn.maneuvers)]
     for i in range(N):  # every ship placed last, so no steady-state search disturbs another
         sim.set_state(i, starts[i])
         sim.set_helm(i, [(H.HEADING, scn.heading, *ap)])

@@ -27,7 +27,7 @@ from vtrials.trials.crew import Crew
 from vtrials.errors import InputError, SimulationError
 from vtrials.instruments.suite import InstrumentSet
 from vtrials.records.netcdf import atomic_path, open_record, write_groups
-from vtrials.scenario import Scenario, environment_block
+from vtrials.scenario import Scenario, environment_block, sea_vessel
 from vtrials.runner.outputs import json_clean
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.records.trial import write_record
@@ -50,8 +50,15 @@ class AgendaResult:
         return self.crew.attempts
 
 
-def _initial_state(sim: Simulator, scn: Scenario) -> ShipState:
-    """Steady at the first run's setting on its course, or the scenario's [initial] if it has one."""
+def _initial_state(sim: Simulator, scn: Scenario, calm: Simulator | None = None) -> ShipState:
+    """Steady at the first run's setting on its course, or the scenario's [initial] if it has one.
+
+    ``calm``: a simulator of the calm-water ship in which to find that condition when ``sim`` carries
+    a seaway (the steady search would otherwise balance one instant's wave excitation); the ship
+    then starts in the sea from the calm-water steady condition and settles within the approach."""
+    place = sim
+    if calm is not None:
+        sim = calm
     v = scn.vessel
     first = scn.agenda.runs[0]
     f = str(scn.path)
@@ -78,7 +85,7 @@ def _initial_state(sim: Simulator, scn: Scenario) -> ShipState:
         back = abs(s.u) * (2.0 * rules.runout_s + rules.approach_s + 0.5 * first.duration)
         c = scn.site.get("range_center", [0.0, 0.0])
         s = dataclasses.replace(s, x=c[0] - back * math.cos(heading), y=c[1] - back * math.sin(heading))
-    sim.set_state(0, s)
+    place.set_state(0, s)
     return s
 
 
@@ -86,8 +93,14 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     t_wall = time.perf_counter()
     timings = {}
     vessel = scn.vessel
-    sim = Simulator(vessel, 1, scn.head.timestep_s, environment_block(scn), record_every=scn.head.record_every)
-    _initial_state(sim, scn)
+    # in a seaway the ship carries the wave components (vtrials.scenario.sea_vessel); the calm-water
+    # references below (tank prediction, calm-water speed-power, steady turns) keep scn.vessel
+    ship, _dropped = sea_vessel(scn)
+    env = environment_block(scn)
+    sim = Simulator(ship, 1, scn.head.timestep_s, env, record_every=scn.head.record_every)
+    calm = None if ship is vessel else Simulator(vessel, 1, scn.head.timestep_s, env, record_every=0)
+    _initial_state(sim, scn, calm)
+    timings["sea_setup_s"] = time.perf_counter() - t_wall
     iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path))
     iset.reset()
     crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)

@@ -6,8 +6,8 @@ waves"; slow-drift oscillations are not modelled), D the database's far-field dr
 squared (:mod:`vtrials.physics.seakeeping.database`: surge [N/m²], sway [N/m²], yaw [N m/m²]), with
 β_j = μ_j − ψ the component's heading relative to the ship at this step (linear interpolation over
 the database headings, mirror image for β < 0: sway and yaw change sign). Zero-speed drift: at forward
-speed this is the database's value, not an added-resistance method (STAWAVE-2 / SNNM are not
-implemented). The force is horizontal (seakeeping frame) and turned into body axes.
+speed this is the database's value, not an added-resistance method (the forward-speed SNNM method is
+:mod:`vtrials.physics.forces.added_resistance`; :mod:`vtrials.physics.seakeeping.sea_ship` chooses). The force is horizontal (seakeeping frame) and turned into body axes.
 
 Parameter block: [n, nβ, headings(nβ), then per component a², cos μ, sin μ and the table (nβ × 3)
 of D at the component's frequency].
@@ -26,8 +26,10 @@ from vtrials.physics.forces._wavetable import heading_fold, lerp
 from vtrials.physics.forces.registry import register
 
 
-def pack(db, components: np.ndarray) -> np.ndarray:
-    """Parameter block for database ``db`` (with drift) and wave components (n, 6)."""
+def pack(db, components: np.ndarray, dofs=(0, 1, 2)) -> np.ndarray:
+    """Parameter block for database ``db`` (with drift) and wave components (n, 6). ``dofs``: which
+    of surge (0), sway (1), yaw (2) the drift acts in (the others are zeroed in the table; e.g. (1, 2)
+    when another method gives the surge force, :mod:`vtrials.physics.seakeeping.sea_ship`)."""
     if db.drift is None:
         raise InputError(db.attrs.get("_path", "database"), "mean_drift_force", "not in this database")
     comp = np.asarray(components, dtype=np.float64)
@@ -37,9 +39,14 @@ def pack(db, components: np.ndarray) -> np.ndarray:
     if h.size < 2 or abs(h[0]) > 1e-9 or abs(h[-1] - math.pi) > 1e-9 or np.ptp(np.diff(h)) > 1e-9:
         raise InputError(db.attrs.get("_path", "database"), "heading",
                          "wave_drift needs equally spaced headings from 0 to pi")
+    keep = np.zeros(3)
+    for d in dofs:
+        if d not in (0, 1, 2):
+            raise InputError("wave_drift", "dofs", f"expected drift DOFs among 0 (surge), 1 (sway), 2 (yaw), got {dofs!r}")
+        keep[d] = 1.0
     out = [np.array([comp.shape[0], h.size]), h]
     for a, w, _k, cm, sm, _eps in comp:
-        D = np.array([[np.interp(w, db.omega, db.drift[:, ib, j]) for j in range(3)] for ib in range(h.size)])
+        D = np.array([[np.interp(w, db.omega, db.drift[:, ib, j]) for j in range(3)] for ib in range(h.size)]) * keep
         out += [np.array([a * a, cm, sm]), D.ravel()]
     return np.concatenate(out).astype(np.float64)
 

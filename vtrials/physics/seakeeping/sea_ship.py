@@ -1,0 +1,46 @@
+"""A ship in a seaway as the runners simulate it: the seakeeping vessel plus the mean wave force chosen.
+
+:func:`sea_ship` = :func:`vtrials.physics.seakeeping.timedomain.seakeeping_vessel` (maneuvering model,
+A∞ in the heave/roll/pitch added mass, radiation memory, first-order excitation) with
+
+* the horizontal added-mass Coriolis terms of the A∞ block (:mod:`vtrials.physics.forces.seakeeping_coriolis`)
+  when the hull model's vessel file applies none (``added_mass.coriolis = "none"``): without them the
+  linear model has a spurious second-order mean surge force (the zero-speed "creep");
+* the mean second-order wave force, ``mean_force``:
+  - ``"snnm"`` (default): surge from the SNNM added-resistance method at the ship's instantaneous speed
+    and heading (:mod:`vtrials.physics.forces.added_resistance`, Liu & Papanikolaou 2020), sway and yaw
+    from the database's zero-speed drift (:mod:`vtrials.physics.forces.wave_drift`, surge column dropped);
+  - ``"database"``: the database's zero-speed far-field drift in surge, sway and yaw (no speed effect);
+  - ``"none"``: no mean wave force (first-order motions only).
+Nothing is counted twice: the maneuvering model's calm-water resistance is unchanged and only one
+source gives each mean force component.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vtrials.errors import InputError
+from vtrials.physics.forces import added_resistance, seakeeping_coriolis, wave_drift
+from vtrials.physics.forces.registry import Component
+from vtrials.physics.seakeeping.timedomain import seakeeping_vessel
+
+MEAN_FORCES = ("snnm", "database", "none")
+
+
+def sea_ship(vessel, db, components: np.ndarray, dt: float, model=None, mean_force: str = "snnm",
+             excitation_dofs=(0, 1, 2, 3, 4, 5)):
+    """(vessel, radiation model) for ``vessel`` in the seaway ``components`` (n, 6) with database ``db``."""
+    if mean_force not in MEAN_FORCES:
+        raise InputError("sea_ship", "mean_force", f"{mean_force!r} is not one of {', '.join(MEAN_FORCES)}")
+    v, model = seakeeping_vessel(vessel, db, components, dt, model=model, excitation_dofs=excitation_dofs,
+                                 drift=(mean_force == "database"))
+    comps = list(v.components)
+    if vessel.added_mass.coriolis == "none":
+        comps.append(Component("seakeeping_coriolis", "seakeeping_coriolis", seakeeping_coriolis.pack(v.M_A)))
+    if mean_force == "snnm":
+        comps.append(Component("added_resistance", "added_resistance",
+                               added_resistance.pack(added_resistance.snnm_hull(vessel), components)))
+        comps.append(Component("wave_drift", "wave_drift", wave_drift.pack(db, components, dofs=(1, 2))))
+    v.components = comps
+    return v, model
