@@ -27,7 +27,7 @@ from vtrials.physics.environment.waves import Waves, realize, spectrum, peak_fre
 from vtrials.physics.seakeeping import rao as rao_mod
 from vtrials.physics.seakeeping.database import load_database
 from vtrials.physics.seakeeping.radiation import fit_radiation
-from vtrials.physics.seakeeping.timedomain import seakeeping_vessel, viscous_roll_damping
+from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
 from vtrials.physics import steering as H
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
