@@ -47,8 +47,9 @@ def kirchhoff_coriolis(M: np.ndarray, nu: np.ndarray, munk: bool = True) -> np.n
     return out
 
 
-def _set(sim, base_q, base_v, eta, nu):
-    """Place ship 0: position/angles perturbed by eta (x, y, z, φ, θ, ψ), body velocities nu."""
+def _set(sim, base_q, base_v, eta, nu, delta=0.0):
+    """Place ship 0: position/angles perturbed by eta (x, y, z, φ, θ, ψ), body velocities nu, all
+    rudders at angle delta [rad]."""
     from vtrials.physics.simulator import euler_to_quat
     from vtrials.physics import dynamics as DY
     q = sim.qpos[0]
@@ -58,6 +59,8 @@ def _set(sim, base_q, base_v, eta, nu):
     q[0:3] = eta[0:3]
     quat = euler_to_quat(eta[3], eta[4], eta[5])
     q[3:7] = quat
+    for k in range(sim.nr):
+        q[int(sim.steer[k, 3])] = delta
     R = np.zeros(9)
     DY.quat_to_mat(*quat, R)
     v[0:3] = R.reshape(3, 3) @ nu[:3]
@@ -69,7 +72,8 @@ def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a:
     """(τ0, J_ν, J_η, R_η) of a seakeeping vessel at ``start`` (a :class:`~vtrials.physics.simulator.ShipState`
     with speed u, zero angles and the shaft speeds): the sum of its force components other than the wave
     components, by central differences of the kernels (via ``Simulator.evaluate``: forces at a state, no
-    time step). J_ν (6×6) per body velocity, J_η (6×6) per (x, y, z, φ, θ, ψ) including the weight."""
+    time step). J_ν (6×6) per body velocity, J_η (6×6) per (x, y, z, φ, θ, ψ) including the weight,
+    J_δ (6,) per rudder angle (all rudders together). Returns (τ0, J_ν, J_η, J_δ)."""
     from vtrials.physics.simulator import Simulator
     sim = Simulator(vessel, 1, dt)
     sim.set_state(0, start)
@@ -81,8 +85,8 @@ def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a:
     mg = vessel.mass * 9.80665
     rG = vessel.r_G
 
-    def tau(eta, nu):
-        R = _set(sim, base_q, base_v, eta, nu)
+    def tau(eta, nu, delta=0.0):
+        R = _set(sim, base_q, base_v, eta, nu, delta)
         sim.evaluate()
         t = sim.comp_w[0, keep].sum(axis=0)
         g = mg * R[6:9]                              # weight in body axes (world z down)
@@ -98,8 +102,9 @@ def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a:
         d = np.zeros(6)
         d[j] = eps_a
         Je[:, j] = (tau(eta0 + d, nu0) - tau(eta0 - d, nu0)) / (2 * eps_a)
+    Jd = (tau(eta0, nu0, eps_a) - tau(eta0, nu0, -eps_a)) / (2 * eps_a)
     _set(sim, base_q, base_v, eta0, nu0)
-    return t0, Jv, Je
+    return t0, Jv, Je, Jd
 
 
 def coriolis_jacobian(vessel, U: float, eps: float = 1e-4) -> np.ndarray:
@@ -123,18 +128,26 @@ def coriolis_jacobian(vessel, U: float, eps: float = 1e-4) -> np.ndarray:
 
 
 def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_damping=None, amplitude: float = 0.0,
-                iters: int = 30) -> np.ndarray:
+                iters: int = 30, excitation_dofs=(0, 1, 2, 3, 4, 5), Jd=None, autopilot=None) -> np.ndarray:
     """Complex RAO (nω, 6) of (x, y, z, φ, θ, ψ) per metre of wave amplitude of the coupled system above.
 
     vessel: the seakeeping vessel (its M_RB and M_A, i.e. A∞ in heave/roll/pitch); Jv, Je, Jc from
     :func:`force_jacobians` and :func:`coriolis_jacobian`; roll_damping: its quadratic part B₂(U) is
-    linearised at the roll amplitude ``amplitude`` × |RAO_φ| (iterated); its linear part is already in Jv."""
+    linearised at the roll amplitude ``amplitude`` × |RAO_φ| (iterated); its linear part is already in Jv.
+    ``excitation_dofs``: the DOFs the wave excitation acts on (as the wave_excitation component's mask).
+    ``autopilot`` = (K_p, K_i [1/s], K_d [s], T [s]) with ``Jd``: the heading autopilot of
+    :mod:`vtrials.physics.steering` (δ_c = −(K_p ψ + K_i ∫ψ + K_d r)) through the steering gear's
+    first-order follow-up δ̇ = (δ_c − δ)/T (rate limit not reached), i.e. a rudder force
+    J_δ δ̂ with δ̂ = −(K_p + K_i/(iω_e) + K_d iω_e) ψ̂ / (1 + iω_e T)."""
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     we = encounter_frequency(omega, beta, U, db.g)
     A, B = extended_coefficients(db.omega, db.A, db.B, db.A_inf, np.abs(we))
     X = db.excitation(beta)
     Xw = np.array([[np.interp(w, db.omega, X[:, j].real) + 1j * np.interp(w, db.omega, X[:, j].imag)
                     for j in range(6)] for w in omega])
+    mask = np.zeros(6)
+    mask[list(excitation_dofs)] = 1.0
+    Xw = Xw * mask
     M = vessel.M_RB + vessel.M_A
     E = np.zeros((6, 6))
     E[1, 5] = -1.0
@@ -145,6 +158,9 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
     for n, w in enumerate(we):
         T = 1j * w * np.eye(6) + U * E
         Z = 1j * w * M @ T - Jv @ T + Jc @ T - Je
+        if autopilot is not None:
+            kp, ki, kd, tg = autopilot
+            Z[:, 5] += np.asarray(Jd) * (kp + ki / (1j * w) + kd * 1j * w) / (1.0 + 1j * w * tg)
         Kh = B[n] + 1j * w * (A[n] - db.A_inf)
         Z[idx] += 1j * w * Kh[idx]
         phi_a = 0.0
