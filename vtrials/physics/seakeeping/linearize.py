@@ -128,7 +128,8 @@ def coriolis_jacobian(vessel, U: float, eps: float = 1e-4) -> np.ndarray:
 
 
 def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_damping=None, amplitude: float = 0.0,
-                iters: int = 30, excitation_dofs=(0, 1, 2, 3, 4, 5), Jd=None, autopilot=None) -> np.ndarray:
+                iters: int = 30, excitation_dofs=(0, 1, 2, 3, 4, 5), Jd=None, autopilot=None,
+                roll_beq=None) -> np.ndarray:
     """Complex RAO (nω, 6) of (x, y, z, φ, θ, ψ) per metre of wave amplitude of the coupled system above.
 
     vessel: the seakeeping vessel (its M_RB and M_A, i.e. A∞ in heave/roll/pitch); Jv, Je, Jc from
@@ -138,7 +139,9 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
     ``autopilot`` = (K_p, K_i [1/s], K_d [s], T [s]) with ``Jd``: the heading autopilot of
     :mod:`vtrials.physics.steering` (δ_c = −(K_p ψ + K_i ∫ψ + K_d r)) through the steering gear's
     first-order follow-up δ̇ = (δ_c − δ)/T (rate limit not reached), i.e. a rudder force
-    J_δ δ̂ with δ̂ = −(K_p + K_i/(iω_e) + K_d iω_e) ψ̂ / (1 + iω_e T)."""
+    J_δ δ̂ with δ̂ = −(K_p + K_i/(iω_e) + K_d iω_e) ψ̂ / (1 + iω_e T).
+    ``roll_beq``: a fixed equivalent linear roll damping [N m s] added instead of the harmonic
+    linearisation of B₂ (e.g. the stochastic one for irregular seas)."""
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     we = encounter_frequency(omega, beta, U, db.g)
     A, B = extended_coefficients(db.omega, db.A, db.B, db.A_inf, np.abs(we))
@@ -163,6 +166,11 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
             Z[:, 5] += np.asarray(Jd) * (kp + ki / (1j * w) + kd * 1j * w) / (1.0 + 1j * w * tg)
         Kh = B[n] + 1j * w * (A[n] - db.A_inf)
         Z[idx] += 1j * w * Kh[idx]
+        if roll_beq is not None:
+            Zn = Z.copy()
+            Zn[3, 3] += 1j * w * roll_beq
+            out[n] = np.linalg.solve(Zn, Xw[n])
+            continue
         phi_a = 0.0
         for _ in range(iters):
             Zn = Z.copy()
