@@ -28,7 +28,15 @@ How the two models combine (nothing counted twice):
 * Forward speed: no speed corrections are added. The dynamics apply A∞ to body-axis accelerations,
   and the body heave velocity is w = ż + Uθ, so the time domain carries a speed coupling
   A∞_i3 U θ̇ (the A∞ part of Salvesen–Tuck–Faltinsen's B35 = B35⁰ + U A33); the matching RAO is
-  :func:`.rao.rao` with ``body_axes_added_mass=True``.
+  :func:`.rao.rao` with ``body_axes_added_mass=True`` for heave and pitch in head seas.
+* The frequency-domain reference for this whole coupled system (free sway and yaw under the
+  maneuvering model, its speed-dependent sway–roll–yaw hull terms, autopilot and steering) is
+  :func:`.linearize.coupled_rao`; :func:`.rao.rao` holds the horizontal DOFs, which in beam and
+  oblique seas differs from the simulated ship by 5–9 % in roll at zero speed and 15–31 % at 5 m/s
+  (patrol51). Physically, roll with free sway is what a real ship has; but here the free sway is the
+  maneuvering model's (BC93 Y_v̇, Y_ṗ, K_v̇) while A44(ω) is the database's with sway held, so the
+  simulated roll resonance (patrol51: 0.86 rad/s) is not the database's free-ship one (≈ 1.0–1.1
+  rad/s; hydro/README.md).
 * Restoring stays the ship file's hydrostatics component (not the database mesh's C): for patrol51 the
   roll stiffness is BC93's GM_T 1.1 m (the roll period and the hull derivatives belong to it), while
   the meshed stand-in hull has GM_T 2.61 m (models/patrol51/hydro/README.md: a known inconsistency of
