@@ -181,3 +181,27 @@ def test_encounter_frequency_and_errors():
         rao_mod.rao(db, [0.5], 0.0, U=9.80665 / 0.5)
     with pytest.raises(InputError, match="dofs"):
         rao_mod.rao(db, [0.5], 0.0, dofs=(8,))
+
+
+def test_coupled_rao_reduces_to_held_rao():
+    """:func:`vtrials.physics.seakeeping.linearize.coupled_rao` with the horizontal DOFs made immovable
+    (surge, sway and yaw masses × 1e9), no hull forces and zero speed is the plain RAO with those DOFs held
+    (:func:`rao.rao`, dofs (2, 3, 4)): the sign, phase and radiation conventions of the coupled solve."""
+    import types
+    from vtrials.physics.seakeeping import linearize as LZ
+    db = load_database(ROOT / "models" / "patrol51" / "hydro" / "patrol51_hydro.nc")
+    M_RB = db.mass_matrix.copy()
+    M_A = np.zeros((6, 6))
+    M_A[np.ix_(DOFS, DOFS)] = db.A_inf[np.ix_(DOFS, DOFS)]
+    for j in (0, 1, 5):
+        M_A[j, j] = 1e9 * M_RB[0, 0] * (1.0 if j < 3 else 100.0)
+    ves = types.SimpleNamespace(M_RB=M_RB, M_A=M_A)
+    w = np.linspace(0.4, 2.0, 9)
+    bv = np.zeros((6, 6))
+    bv[3, 3] = 3.0e5
+    Jv = -bv
+    for beta in (math.pi / 2, 3 * math.pi / 4):
+        c = LZ.coupled_rao(ves, db, w, beta, 0.0, Jv, -db.C, np.zeros((6, 6)))
+        h = rao_mod.rao(db, w, beta, 0.0, DOFS, M=M_RB, C=db.C, B_visc=bv)
+        for d in DOFS:
+            assert np.allclose(c[:, d], h[:, d], rtol=1e-4, atol=1e-6 * np.abs(h[:, d]).max()), (beta, d)

@@ -421,7 +421,40 @@ def _readme(setup: ShipSetup, hyd: dict, levels: list, changes: list, attrs: dic
               "Kramers–Kronig between A and B; drift signs, symmetry and the short-wave beam-sea limit; "
               "the convergence figures above.", ""]
     lines += checks.get("extra", [])
+    lines += _time_domain_section(setup, C)
     return "\n".join(lines)
+
+
+def _time_domain_section(setup: ShipSetup, C: np.ndarray) -> list:
+    """README section: how the simulator uses this database (restoring, roll damping, sway-roll coupling)."""
+    gm_mesh = setup.model_hydrostatics["GM_T"] * C[3, 3] / setup.model_C[3, 3]
+    out = ["", "## Use in the time domain (vtrials.physics.seakeeping.timedomain)", "",
+           f"* Roll restoring: the simulator uses ship.toml's GM_T = {setup.model_hydrostatics['GM_T']} m "
+           f"(hydrostatics component, C44 = {setup.model_C[3, 3]:.4e} N m), not this database's C44 = {C[3, 3]:.4e} "
+           f"N m (GM_T ≈ {gm_mesh:.2f} m of the meshed hull). The frequency-domain references "
+           "(`rao.rao(..., C=vessel.restoring_matrix())`, `linearize.coupled_rao`) use the same ship.toml restoring, "
+           "so simulator and references agree; the database's C is a diagnostic of the mesh only.",
+           "* Roll damping: the radiation memory gives the wave part; the viscous part is the `roll_damping` "
+           "component set by the `[roll_damping]` table of `hull.toml` (method, bilge keels, each with its source); "
+           "every roll damping term of the maneuvering model is removed from the seakeeping vessel.",
+           "* Horizontal DOFs: surge, sway and yaw keep the maneuvering model (its added mass and hull forces, no "
+           "memory); the database's sway and yaw coefficients are not used by the simulator."]
+    if setup.name == "patrol51":
+        out += ["* Known inconsistency (not resolved here): the wave excitation is the meshed hull's, whose "
+                "waterplane gives BM_T 4.44 m where BC93's KM − KB gives 2.94 m, while the restoring is BC93's "
+                "GM_T 1.1 m. The roll excitation is therefore large for the restoring it meets: in beam seas at the "
+                "roll resonance (0.86 rad/s in the simulator) the roll RAO is ≈ 2.6 rad per metre of wave amplitude "
+                "at zero speed (roll/wave slope ≈ 35); a JONSWAP beam sea of H_s 1.5 m, T_p 8 s rolled it to 62° at 5 m/s in the simulator. A consistent "
+                "model needs a hull mesh with BC93's waterplane (C_WP ≈ 0.61, see `vtrials.resistance`) and a "
+                "rebuilt database.",
+                "* Sway–roll coupling: with the maneuvering model's sway added mass and roll coupling (BC93 Y_v̇, "
+                "Y_ṗ, K_v̇) and this database's A44(ω) about O (computed with sway held), the simulated ship's roll "
+                "resonance is at 0.86 rad/s (T 7.3 s). The database's own free-ship RAO (its sway A22, A24(ω), "
+                "B22 free) peaks near 1.0–1.1 rad/s and is ≈ 6 times smaller at 0.86 rad/s: the roll added inertia "
+                "about O measured with sway held is partly sway-coupling inertia that a ship free to sway does "
+                "not feel. The simulator is matched by `linearize.coupled_rao` (its own coupled system), not by "
+                "the database's free-ship RAO."]
+    return out
 
 
 def write_readme(setup: ShipSetup, nc_path: Path) -> Path:

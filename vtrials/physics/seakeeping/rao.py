@@ -21,7 +21,9 @@ Faltinsen 1970 speed terms) are applied, in the frequency domain nor in the time
 remain comparable; their size at Froude numbers above ≈ 0.2 is not assessed here.
 
 Only the DOFs listed in ``dofs`` move; the others are held (e.g. heave, roll, pitch = (2, 3, 4): the
-horizontal motions are left to the maneuvering model).
+horizontal motions are left to the maneuvering model). The simulated ship's sway and yaw are free under
+its maneuvering model: the reference for its roll in beam and oblique seas is
+:func:`vtrials.physics.seakeeping.linearize.coupled_rao`, not this held-DOF RAO.
 """
 
 from __future__ import annotations

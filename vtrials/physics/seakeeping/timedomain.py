@@ -13,27 +13,45 @@ How the two models combine (nothing counted twice):
     driven by the heave, roll and pitch velocities, which are perturbations about the maneuvering
     motion; the potential damping is therefore in the memory, and the ship file's linear heave and
     pitch damping is removed;
-  - roll keeps the ship file's roll damping (linear fraction of critical + quadratic) as the
-    viscous part (a documented equivalent linearisation standing in for Ikeda's method, which is not
-    implemented here); the wave-radiation part of roll damping comes from the memory.
+  - roll: the wave part of roll damping comes from the memory; the viscous part is the
+    ``roll_damping`` component (:mod:`vtrials.physics.forces.roll_damping`), set by the model's
+    ``hydro/hull.toml`` ``[roll_damping]`` table. Every roll damping term of the maneuvering model is
+    removed so that nothing is counted twice: the ship file's roll_ratio / roll_quadratic (damping
+    component) and, for the Blanke hull, K_p, K_|u|p and K_p|p| (BC93's measured roll damping, which
+    includes the wave part). ``method = "ikeda"``: Ikeda's viscous components (friction, eddy,
+    lift, bilge keels); ``method = "hull_model"``: those removed terms come back in the component,
+    less the database's potential damping B44(ω_n) at the natural roll frequency (so the total at
+    ω_n is the ship file's, the wave part now frequency-dependent from the memory).
 * Mean drift (surge, sway, yaw): the database's zero-speed drift per component
   (:mod:`vtrials.physics.forces.wave_drift`); the maneuvering model's calm-water resistance is unchanged,
   so the added resistance is this force alone.
 * Forward speed: no speed corrections are added. The dynamics apply A∞ to body-axis accelerations,
   and the body heave velocity is w = ż + Uθ, so the time domain carries a speed coupling
   A∞_i3 U θ̇ (the A∞ part of Salvesen–Tuck–Faltinsen's B35 = B35⁰ + U A33); the matching RAO is
-  :func:`.rao.rao` with ``body_axes_added_mass=True``.
-* Roll damping: patrol51's ship file has zero roll damping (only the potential damping of the memory
-  then acts); kvlcc2's is 6.1e9 N m s/rad. Ikeda's method and bilge keels are not implemented.
-* Restoring stays the ship file's hydrostatics component (not the database mesh's C).
+  :func:`.rao.rao` with ``body_axes_added_mass=True`` for heave and pitch in head seas.
+* The frequency-domain reference for this whole coupled system (free sway and yaw under the
+  maneuvering model, its speed-dependent sway–roll–yaw hull terms, autopilot and steering) is
+  :func:`.linearize.coupled_rao`; :func:`.rao.rao` holds the horizontal DOFs, which in beam and
+  oblique seas differs from the simulated ship by 5–9 % in roll at zero speed and 15–31 % at 5 m/s
+  (patrol51). Physically, roll with free sway is what a real ship has; but here the free sway is the
+  maneuvering model's (BC93 Y_v̇, Y_ṗ, K_v̇) while A44(ω) is the database's with sway held, so the
+  simulated roll resonance (patrol51: 0.86 rad/s) is not the database's free-ship one (≈ 1.0–1.1
+  rad/s; hydro/README.md).
+* Restoring stays the ship file's hydrostatics component (not the database mesh's C): for patrol51 the
+  roll stiffness is BC93's GM_T 1.1 m (the roll period and the hull derivatives belong to it), while
+  the meshed stand-in hull has GM_T 2.61 m (models/patrol51/hydro/README.md: a known inconsistency of
+  the stand-in hull's waterplane; the database's roll excitation belongs to the meshed hull).
 """
 
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import numpy as np
 
+from vtrials.errors import InputError
+from vtrials.physics.forces import roll_damping as rd_mod
 from vtrials.physics.forces import hydrostatics
 from vtrials.physics.forces import radiation as rad_force
 from vtrials.physics.forces import wave_drift, wave_excitation
@@ -43,16 +61,57 @@ from vtrials.physics.seakeeping.radiation import fit_radiation
 SEAKEEPING_DOFS = (2, 3, 4)
 
 
+def roll_damping_of(vessel, db, hull_toml=None):
+    """The viscous roll damping (:class:`vtrials.physics.forces.roll_damping.RollDamping`) the seakeeping
+    vessel gets, from the ``[roll_damping]`` table of ``hull_toml`` (default: ``hull.toml`` next to the
+    database). Its frequency-dependent parts are taken at the natural roll frequency of the vessel's
+    mass and restoring with the database's A44(ω) (:func:`.rao.natural_frequency`)."""
+    from vtrials.physics.seakeeping.hullform import hull_particulars_from_table
+    from vtrials.physics.seakeeping.rao import natural_frequency
+    from vtrials.schema import load_toml
+    path = Path(hull_toml) if hull_toml is not None else Path(db.attrs["_path"]).parent / "hull.toml"
+    tab = rd_mod.read_roll_damping_table(path)
+    wn = natural_frequency(db, 3, M=vessel.M_RB, C=vessel.restoring_matrix())
+    if tab.method == "ikeda":
+        hp = hull_particulars_from_table(load_toml(path)["hull"], str(path))
+        P = vessel.particulars
+        h = rd_mod.RollHull(L=hp.length, B=hp.beam, d=hp.draught, C_B=hp.C_B, C_M=hp.C_M,
+                            OG=P.draught - P.KG, l_BK=tab.bilge_keel_length, b_BK=tab.bilge_keel_breadth,
+                            rho=P.water_density, nu=tab.kinematic_viscosity)
+        return rd_mod.ikeda(h, wn, where=str(path))
+    # hull_model: the maneuvering model's own roll damping, less the wave part the memory now supplies
+    b1, b1u, b2 = float(vessel.B_lin[1]), 0.0, float(vessel.damping.roll_quadratic)
+    if vessel.meta.hull_model == "blanke":
+        b1 -= vessel.hull.K_p
+        b1u -= vessel.hull.K_up
+        b2 -= vessel.hull.K_pp
+    b44w = float(np.interp(wn, db.omega, db.B[:, 3, 3]))
+    if b1 < b44w:
+        raise InputError(str(path), "roll_damping.method", f"'hull_model': the ship file's linear roll damping "
+                         f"{b1:.4g} N m s is below the database's wave damping {b44w:.4g} N m s at ω_n = {wn:.3f} "
+                         "rad/s; there is no viscous part left to keep (use 'ikeda')")
+    return rd_mod.RollDamping(wn, b1 - b44w, b1u, 0.0, 0.0, b2,
+                              f"maneuvering model's roll damping less the database's B44({wn:.3f} rad/s) = {b44w:.4g} N m s",
+                              (("ship-file linear", b1), ("wave part removed", b44w), ("per m/s", b1u),
+                               ("quadratic", b2)))
+
+
 def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
-                      excitation_dofs=(0, 1, 2, 3, 4, 5), drift: bool = True):
+                      excitation_dofs=(0, 1, 2, 3, 4, 5), drift: bool = True, roll_damping="model"):
     """A shallow copy of ``vessel`` with A∞ in its added mass (heave/roll/pitch block), the damping
     component reduced to its roll (viscous) part, and the radiation and wave-excitation components.
 
     ``components``: wave components (n, 6) of :mod:`vtrials.physics.environment.waves`; ``dt``: the
     simulator step [s] (the radiation states are discretised for it); ``model``: a fitted
     :class:`.radiation.RadiationModel` (fitted here when None); ``drift``: add the mean drift
-    component (:mod:`vtrials.physics.forces.wave_drift`). Returns (vessel, model).
+    component (:mod:`vtrials.physics.forces.wave_drift`); ``roll_damping``: "model" (from the
+    model's hull.toml, :func:`roll_damping_of`), a :class:`~vtrials.physics.forces.roll_damping.RollDamping`,
+    or None (no viscous roll damping at all: potential damping only). Returns (vessel, model).
     """
+    if isinstance(roll_damping, str):
+        if roll_damping != "model":
+            raise InputError("seakeeping_vessel", "roll_damping", f"expected 'model', a RollDamping or None, got {roll_damping!r}")
+        roll_damping = roll_damping_of(vessel, db)
     if model is None:
         model = fit_radiation(db, dofs=SEAKEEPING_DOFS)
     v = copy.copy(vessel)
@@ -66,22 +125,25 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
             p = c.params.copy()
             p[0] = 0.0      # heave: potential damping from the radiation memory
             p[2] = 0.0      # pitch: likewise
+            p[1] = 0.0      # roll: viscous part in the roll_damping component, wave part in the memory
+            p[3] = 0.0
             comps.append(Component("damping", c.type, p))
+        elif c.type == "hull_blanke":
+            p = c.params.copy()
+            p[17] = p[18] = p[19] = 0.0    # K_|u|p, K_p|p|, K_p: as above
+            comps.append(Component(c.name, c.type, p))
         else:
             comps.append(c)
     p, s0 = rad_force.pack(model, dt)
     comps.append(Component("radiation", "radiation", p, states=s0))
     comps.append(Component("wave_excitation", "wave_excitation",
                            wave_excitation.pack(db, components, excitation_dofs)))
+    if roll_damping is not None:
+        comps.append(Component("roll_damping", "roll_damping", rd_mod.pack(roll_damping)))
     if drift:
         comps.append(Component("wave_drift", "wave_drift", wave_drift.pack(db, components)))
     v.components = comps
     return v, model
 
 
-def viscous_roll_damping(vessel) -> float:
-    """The linear roll damping [N m s/rad] kept as the viscous part (the ship file's, see above)."""
-    return float(vessel.B_lin[1])
-
-
-__all__ = ["seakeeping_vessel", "viscous_roll_damping", "hydrostatics"]
+__all__ = ["seakeeping_vessel", "roll_damping_of", "hydrostatics"]
