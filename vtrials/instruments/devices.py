@@ -876,6 +876,12 @@ class ShaftSpeed(ShaftDevice):
     def measurand(self, kin, cols):
         return cols[f"shaft_n_{self.index}"]
 
+    def meta(self):
+        m = super().meta()
+        # the counter's stated accuracy as a standard uncertainty of its reading [rev/s] (catalogue bias sd)
+        m["calibration_uncertainty_rps"] = _dist(self.spec, "bias", self.f)[1]
+        return m
+
 
 class Thrustmeter(ShaftDevice):
     """Thrust-bearing load cells: the propeller thrust plus a static load (submergence, weight,

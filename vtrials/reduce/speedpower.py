@@ -508,6 +508,35 @@ def along_track_acceleration(t, north, east, t0=None, t1=None):
     return float(beta[2]), float(math.sqrt(max(var * t.size / max(t.size - 3, 1), 0.0)))
 
 
+def along_track_acceleration_from_velocity(t, sog, cog, t0=None, t1=None):
+    """Mean acceleration along the track [m/s²] in [t0, t1] and its standard error, from a receiver's
+    own velocity (GNSS Doppler SOG [m/s] and COG [rad]): least-squares slope of the along-track
+    velocity sog·cos(cog − c̄), c̄ the circular mean course. Doppler velocities do not carry the slowly
+    varying errors of the code positions (velocity from the carrier's Doppler shift, a few cm/s;
+    Misra & Enge, Global Positioning System: Signals, Measurements, and Performance, 2nd ed. 2006),
+    so a 10-min run's slope is resolved far better than from the fixes' curvature. The
+    standard error is the sandwich variance of the residuals (gusts and helm make the speed
+    fluctuations coloured, :func:`vtrials.reduce.runstats.sandwich_variance`)."""
+
+    t = np.asarray(t, dtype=float)
+    sog, cog = np.asarray(sog, dtype=float), np.asarray(cog, dtype=float)
+    w = np.isfinite(t) & np.isfinite(sog) & np.isfinite(cog)
+    if t0 is not None:
+        w &= t >= t0
+    if t1 is not None:
+        w &= t <= t1
+    t, sog, cog = t[w], sog[w], cog[w]
+    if t.size < 5:
+        raise ValueError("need at least 5 velocities for an acceleration")
+    c = math.atan2(float(np.sum(sog * np.sin(cog))), float(np.sum(sog * np.cos(cog))))
+    v = sog * np.cos(cog - c)
+    X = np.column_stack([np.ones_like(t), t - t.mean()])
+    P = np.linalg.pinv(X)
+    r = v - X @ (P @ v)
+    var, _ = sandwich_variance(P[1], r)
+    return float(P[1] @ v), float(math.sqrt(max(var * t.size / max(t.size - 2, 1), 0.0)))
+
+
 def displacement_correction(power, disp_trial, disp_target, power_std=None):
     """P₂ = P₁ (∇₂/∇₁)^{2/3} (Admiralty-type displacement correction; ITTC 7.5-04-01-01.1 (2017),
     ISO 15016:2015 — intended for small differences between trial and contract displacement).

@@ -112,14 +112,22 @@ def run_statistics(rec: Record, run: dict) -> dict:
     out["tracking"] = primary
     s = out["sog"][primary]["sog"]
     out["vg"] = Estimate(s["value"], s["std"], s["dof"])
-    if out["sog"][primary].get("kind") != "loran":  # the run's residual acceleration along its track
-        t, n = rec.channel(primary, "north")
-        _, e = rec.channel(primary, "east")
-        try:
+    # the run's residual acceleration along its track: from a receiver's Doppler velocity where there
+    # is one (far less noisy than the fixes' curvature), else from the tracking fixes (not Loran's)
+    gnss = kinds.get("gnss", [])
+    try:
+        if gnss:
+            t, v = rec.channel(gnss[0], "sog")
+            _, c = rec.channel(gnss[0], "cog")
+            a, a_se = SP.along_track_acceleration_from_velocity(t, v, c, t0, t1)
+            out["accel"] = {"value": a, "std": a_se, "source": f"{gnss[0]} velocity"}
+        elif out["sog"][primary].get("kind") != "loran":
+            t, n = rec.channel(primary, "north")
+            _, e = rec.channel(primary, "east")
             a, a_se = SP.along_track_acceleration(t, n, e, t0, t1)
-            out["accel"] = {"value": a, "std": a_se}
-        except ValueError:
-            pass
+            out["accel"] = {"value": a, "std": a_se, "source": f"{primary} fixes"}
+    except ValueError:
+        pass
     # shafts: power from the torque and r/min meters, net thrust, indicated pitch
     shafts = {}
     for name in kinds.get("shaft_torque", []):
@@ -132,8 +140,11 @@ def run_statistics(rec: Record, run: dict) -> dict:
                                                 float(m.get("scale_uncertainty", 0.0)) * (st["mean"] - z))}
         shafts.setdefault(m["shaft_index"], {})["torque"] = st
     for name in kinds.get("shaft_rpm", []):
-        k = rec.meta(name)["shaft_index"]
-        shafts.setdefault(k, {})["rps"] = channels[name]["rps"]
+        m = rec.meta(name)
+        st = channels[name]["rps"]
+        if st is not None:  # the counter's stated accuracy: common to every run with this counter
+            st = {**st, "calibration_std": float(m.get("calibration_uncertainty_rps", 0.0))}
+        shafts.setdefault(m["shaft_index"], {})["rps"] = st
     for name in kinds.get("thrust", []):
         m = rec.meta(name)
         st = channels[name]["thrust"]
@@ -150,8 +161,10 @@ def run_statistics(rec: Record, run: dict) -> dict:
                                         Estimate(n["mean"], n["se"], max(n["n_eff"] - 1, 1)))
             sh["power"] = _est(p)
             power.append(p)
-            # calibration (zero and scale of the torsionmeter): common to every run with this meter
-            syst.append(2 * math.pi * n["mean"] * q.get("calibration_std", 0.0))
+            # calibration (zero and scale of the torsionmeter, the counter's accuracy): common to every
+            # run with these meters
+            syst.append(2 * math.pi * math.hypot(n["mean"] * q.get("calibration_std", 0.0),
+                                                 q["mean"] * n.get("calibration_std", 0.0)))
     out["shafts"] = {str(k): v for k, v in sorted(shafts.items())}
     if power:
         out["power"] = Estimate(sum(p.value for p in power), math.sqrt(sum(p.std ** 2 for p in power)))
