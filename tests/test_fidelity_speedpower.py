@@ -6,10 +6,10 @@ reduction applies, against an exact quadratic track and a receiver's velocity wi
 import json
 import math
 
-import h5py
 import numpy as np
 import pytest
 
+from tests.calibration import drawn_meter_errors, net_of_calibration
 from vtrials import run
 from vtrials.reduce import speedpower as SP
 
@@ -76,23 +76,7 @@ def test_acceleration_from_receiver_velocity():
 def kvlcc2_sp(tmp_path_factory, scenarios_dir):
     out = tmp_path_factory.mktemp("kvlcc2_sp")
     run(scenarios_dir / "kvlcc2_speed_power.toml", out, plot=False)
-    with h5py.File(out / "truth.nc") as f:
-        drawn = json.loads(f["agenda"].attrs["instrument_errors"])
-    return json.loads((out / "results.json").read_text()), drawn
-
-
-def _part(chain, name):
-    return next(p for p in chain["parts"] if p["part"] == name)
-
-
-def calibration_power_error(drawn, rps, torque):
-    """Relative error of 2π n Q from the meters' drawn calibration errors (the trial's draw, read from
-    truth): counter bias b [rev/s], torsionmeter scale s and the zero offset left after zero setting."""
-    b = _part(drawn["rpm"]["chain"], "Bias")["bias"]
-    tq = drawn["torque"]
-    s = _part(tq["chain"], "ScaleFactor")["scale_factor_error"]
-    z = _part(tq["chain"], "Bias")["bias"] - tq["zero_reading_N_m"]
-    return (1.0 + s + z / torque) * (1.0 + b / rps) - 1.0
+    return json.loads((out / "results.json").read_text()), drawn_meter_errors(out / "truth.nc")
 
 
 def test_kvlcc2_speed_power_within_one_percent_in_head_and_tail_wind(kvlcc2_sp):
@@ -100,7 +84,7 @@ def test_kvlcc2_speed_power_within_one_percent_in_head_and_tail_wind(kvlcc2_sp):
     errors of this trial (torsionmeter scale ~0.5 %, counter ~0.25 r/min, both 1σ; seed 002 Table 2)
     are taken out — those no analysis can remove and the stated interval carries them — and the full
     error inside the stated 95 % interval."""
-    res, drawn = kvlcc2_sp
+    res, meters = kvlcc2_sp
     tr = res["trials"][0]
     errs, net = [], []
     for sp, red in zip(tr["error"]["spots"], tr["reduced"]["spots"]):
@@ -110,7 +94,7 @@ def test_kvlcc2_speed_power_within_one_percent_in_head_and_tail_wind(kvlcc2_sp):
         e = sp["power_at_equal_speed"]
         assert e["covered"], e
         errs.append(e["error"])
-        net.append((1.0 + e["error"]) / (1.0 + calibration_power_error(drawn, red["rps"], red["torque"])) - 1.0)
+        net.append(net_of_calibration(e["error"], meters, red["torque"], red["rps"]))
     print("power error at equal speed per spot [%]:", np.round(np.array(errs) * 100, 2),
           "net of the meters' calibration:", np.round(np.array(net) * 100, 2))
     assert len(errs) == 5

@@ -133,11 +133,17 @@ def score_standardization(reduced: dict, res, name: str) -> dict:
 def score_log_calibration(reduced: dict, res, name: str) -> dict:
     crew = res.crew
     truth = _truth_of(crew, name)
+    # the reduction's speed through water is one per group (the joint current fit takes it equal on the
+    # group's legs): its reference is the mean of the legs' true values, as for a standardization spot;
+    # each leg's own true value (head or tail wind moves it by ~0.01 m/s) is kept beside it
+    group_stw = {}
+    for leg in reduced["legs"]:
+        group_stw.setdefault(leg["group"], []).append(truth[leg["run"]]["stw"])
     legs = []
     for leg in reduced["legs"]:
         tr = truth[leg["run"]]
-        c = _cmp(leg["stw"], tr["stw"])
-        legs.append({"run": leg["run"], "group": leg["group"], "stw": c,
+        c = _cmp(leg["stw"], float(np.mean(group_stw[leg["group"]])))
+        legs.append({"run": leg["run"], "group": leg["group"], "stw": c, "stw_leg_truth": tr["stw"],
                      "stw_error_kn": None if c["error"] is None else c["error"] / KNOT,
                      "sog": _cmp(leg["vg"], tr["sog"]),
                      "true_current": [tr["current_n"], tr["current_e"]]})
@@ -226,9 +232,45 @@ def _spiral_points(red_pts: list, true_pts: list) -> list:
     return out
 
 
+def drift_corrected_turns(truth: dict) -> dict:
+    """Turn references on the track through the water less the trial's mean loop drift.
+
+    A trials team corrects a turning circle for its drift — the track's displacement between
+    positions one loop apart (ITTC Recommended Procedure 7.5-04-02-01, Full Scale Manoeuvring Trials, turning circle
+    analysis) — which holds the current and also the wind's leeway of the circling ship; the
+    reduction averages it over the day's circles of both sides. The reference is taken by the same
+    definition: the track through the water (current removed exactly) less the true leeway, the mean
+    over the trial's turns of each one's water-track drift from 360° to 720° (the part that flips with
+    the side of the turn averages out, as in the reduction). Advance, transfer and tactical diameter
+    are corrected to first order (position less drift × time from EXECUTE); the water-track values are
+    kept as ``*_water_track_m``. Turns shorter than 720° give no drift; with none, nothing changes."""
+    loops = [r["loop_drift_mps"] for r in truth.values() if r.get("loop_drift_mps")]
+    if not loops:
+        return truth
+    dn, de = np.mean(loops, axis=0)
+    out = {}
+    for k, r in truth.items():
+        if r.get("type") not in ("turn", "pull_out") or "approach_heading_rad" not in r:
+            out[k] = r
+            continue
+        c, s = math.cos(r["approach_heading_rad"]), math.sin(r["approach_heading_rad"])
+        along, across = dn * c + de * s, -dn * s + de * c
+        r = {**r, "leeway_drift_mps": [float(dn), float(de)]}
+        if "time_to_90deg_s" in r:
+            t90 = r["time_to_90deg_s"]
+            r["advance_water_track_m"], r["transfer_water_track_m"] = r["advance_m"], r["transfer_m"]
+            r["advance_m"] = r["advance_m"] - along * t90
+            r["transfer_m"] = abs(r["transfer_signed_m"] - across * t90)
+        if "time_to_180deg_s" in r:
+            r["tactical_diameter_water_track_m"] = r["tactical_diameter_m"]
+            r["tactical_diameter_m"] = abs(r["tactical_signed_m"] - across * r["time_to_180deg_s"])
+        out[k] = r
+    return out
+
+
 def score_maneuvering(reduced: dict, res, name: str) -> dict:
     crew = res.crew
-    truth = _truth_of(crew, name)
+    truth = drift_corrected_turns(_truth_of(crew, name))
     runs = []
     worst = {"turn_rel": 0.0, "reach_rel": 0.0, "overshoot_deg": 0.0}
     cover = []

@@ -70,15 +70,26 @@ def turning(t, x_w, y_w, heading, u_r, v_r, r, *, steady_from_deg: float = 360.0
     xi = ex * c + ey * s
     eta = -ex * s + ey * c
     out: dict = {}
+    out["approach_heading_rad"] = float(psi0)
     c90 = _first_crossing(t, dpsi, math.radians(90.0))
     if c90 is not None:
         out["advance_m"] = _interp(t, xi, c90[0])
         out["transfer_m"] = abs(_interp(t, eta, c90[0]))
+        out["transfer_signed_m"] = _interp(t, eta, c90[0])
         out["time_to_90deg_s"] = c90[0] - t[0]
     c180 = _first_crossing(t, dpsi, math.radians(180.0))
     if c180 is not None:
         out["tactical_diameter_m"] = abs(_interp(t, eta, c180[0]))
+        out["tactical_signed_m"] = _interp(t, eta, c180[0])
         out["time_to_180deg_s"] = c180[0] - t[0]
+    # the water track's own drift over the second loop (360° to 720°: same heading, one loop apart):
+    # the wind's leeway of the circling ship, which a trials team's drift correction also removes
+    c360 = _first_crossing(t, dpsi, 2.0 * math.pi)
+    c720 = _first_crossing(t, dpsi, 4.0 * math.pi)
+    if c360 is not None and c720 is not None and c720[0] > c360[0]:
+        dt = c720[0] - c360[0]
+        out["loop_drift_mps"] = [(_interp(t, x_w, c720[0]) - _interp(t, x_w, c360[0])) / dt,
+                                 (_interp(t, y_w, c720[0]) - _interp(t, y_w, c360[0])) / dt]
     total = float(dpsi[-1])
     lo, hi = math.radians(steady_from_deg), math.radians(steady_to_deg)
     if total < hi:
