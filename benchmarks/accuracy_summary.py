@@ -20,6 +20,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results" / "accuracy.json"
+if str(ROOT) not in sys.path:  # tests.calibration (scoring-side helper) from any working directory
+    sys.path.insert(0, str(ROOT))
 
 
 def agenda_scenarios() -> list[Path]:
@@ -39,6 +41,13 @@ def _run(scenario: str, out: str) -> dict:
         spots = err.get("spots")
         if spots:
             row["spot_power_error"] = [s.get("curve_error") for s in spots]
+            # the same with the meters' drawn calibration errors taken out (the reduction's own share)
+            from tests.calibration import drawn_meter_errors, net_of_calibration
+            meters = drawn_meter_errors(Path(out) / "truth.nc")
+            row["spot_power_error_net_of_meters"] = [
+                None if s.get("power_at_equal_speed", {}).get("error") is None or not meters else
+                net_of_calibration(s["power_at_equal_speed"]["error"], meters, r["torque"], r["rps"])
+                for s, r in zip(spots, t["reduced"]["spots"])]
         trials.append(row)
     return {"scenario": Path(scenario).name, "ship": res["ship"], "simulated_h": res["simulated_time_s"] / 3600,
             "wall_s": res["wall_time_s"], "trials": trials}
@@ -70,10 +79,11 @@ def main(argv: list[str]) -> int:
             if t.get("spot_power_error"):
                 pe = [e for e in t["spot_power_error"] if e is not None]
                 text += f"; spot power error {min(pe):+.2%} … {max(pe):+.2%}" if pe else ""
+                pn = [e for e in t.get("spot_power_error_net_of_meters") or [] if e is not None]
+                text += f" (net of the meters' calibration {min(pn):+.2%} … {max(pn):+.2%})" if pn else ""
             print(f"| {r['scenario']} | {t['trial']} | {t['kind']} | {text} |")
     return 0
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, str(ROOT))
     raise SystemExit(main(sys.argv[1:]))
