@@ -14,7 +14,8 @@ from scipy.integrate import quad
 
 from vtrials.errors import InputError
 from vtrials.physics.environment.waves import bretschneider_spectrum
-from vtrials.reduce.stawave import raw_motion, raw_reflection, stawave1, stawave1_limit_hs, stawave2
+from vtrials.reduce.stawave import (METHOD_REL_STD, observed_spectrum, raw_motion, raw_reflection,
+                                    run_wave_resistance, stawave1, stawave1_limit_hs, stawave2)
 from vtrials.units import G
 
 SHIP = dict(L_pp=200.0, B=32.0, T=12.0, C_B=0.80, k_yy=0.25)
@@ -72,3 +73,54 @@ def test_stawave2_irregular_integral():
     assert r > 0.0
     with pytest.raises(InputError, match="C_B"):
         stawave2(w, S, V, L_pp=200.0, B=32.0, T=12.0, C_B=1.5)
+
+
+def test_observed_spectrum_against_the_physics_forms():
+    """The team's own spectra: 4√m₀ = H_s on the grid, and the Pierson–Moskowitz shape equal to the
+    simulator's Bretschneider form (an independent implementation of the same formula); JONSWAP peaks
+    at ω_p and is higher there than Pierson–Moskowitz of the same H_s."""
+    w = np.linspace(0.05, 6.0, 6000)
+    pm = observed_spectrum(w, 1.5, 8.0)
+    assert 4.0 * math.sqrt(np.trapezoid(pm, w)) == pytest.approx(1.5, rel=1e-9)
+    ref = bretschneider_spectrum(w, 1.5, 2 * math.pi / 8.0)
+    assert np.max(np.abs(pm - ref)) < 5e-3 * ref.max()
+    js = observed_spectrum(w, 1.5, 8.0, gamma=3.3)
+    assert w[np.argmax(js)] == pytest.approx(2 * math.pi / 8.0, abs=2e-3)
+    assert js.max() > 1.5 * pm.max()
+
+
+def test_run_wave_resistance_by_sector():
+    """Within ±45° of the bow: STAWAVE-2 of the observed sea, uncertainty from H_s (R ∝ H_s²) and the
+    method; outside: half the head-sea value ± 1/√12 of it; a sea from two systems adds."""
+    L, B, T, CB, V = 51.5, 8.6, 2.3, 0.35, 7.0
+    s = {"hs_m": 1.0, "tp_s": 7.5, "gamma": None, "from_rad": math.radians(10.0), "hs_rel_std": 0.05}
+    w = np.linspace(0.2, 6.0, 600) * (2 * math.pi / 7.5)
+    head = stawave2(w, observed_spectrum(w, 1.0, 7.5), V, L, B, T, CB)
+    r, sd = run_wave_resistance([s], math.radians(50.0), V, L, B, T, CB)      # 40° off the bow
+    assert r == pytest.approx(head, rel=1e-12)
+    assert sd == pytest.approx(head * math.hypot(0.10, METHOD_REL_STD), rel=1e-12)
+    r, sd = run_wave_resistance([s], math.radians(60.0), V, L, B, T, CB)      # 50° off: outside
+    assert r == pytest.approx(0.5 * head, rel=1e-12) and sd == pytest.approx(head / math.sqrt(12.0), rel=1e-12)
+    r2, _ = run_wave_resistance([s, {**s, "from_rad": math.radians(190.0)}], math.radians(10.0), V, L, B, T, CB)
+    assert r2 == pytest.approx(1.5 * head, rel=1e-12)
+    assert run_wave_resistance([], 0.0, V, L, B, T, CB) == (0.0, 0.0)
+
+
+def test_observed_sea_is_reproducible_and_scattered_as_stated():
+    """Same seed → the same observation; over 2000 seeds the H_s, T_p and direction errors have the
+    stated standard deviations (within 10 %) and no bias; a calm sea gives nothing; swell is a
+    second system."""
+    from vtrials.instruments.sea_observation import (DIRECTION_STD_RAD, HS_REL_STD, TP_REL_STD,
+                                                     observe_sea)
+    from vtrials.physics.environment.waves import Waves
+    waves = Waves(spectrum="pierson_moskowitz", hs_m=0.88, tp_s=7.5, direction_deg=10.0)
+    assert observe_sea(waves, 5) == observe_sea(waves, 5)
+    obs = [observe_sea(waves, k)[0] for k in range(2000)]
+    hs = np.array([o["hs_m"] for o in obs]) / 0.88 - 1.0
+    tp = np.array([o["tp_s"] for o in obs]) / 7.5 - 1.0
+    dd = np.array([o["from_rad"] for o in obs]) - math.radians(10.0)
+    for e, sd in ((hs, HS_REL_STD), (tp, TP_REL_STD), (dd, DIRECTION_STD_RAD)):
+        assert abs(np.std(e) / sd - 1.0) < 0.1 and abs(np.mean(e)) < 4 * sd / math.sqrt(e.size)
+    assert observe_sea(Waves(), 5) == []
+    two = observe_sea(Waves(spectrum="jonswap", hs_m=1.0, tp_s=6.0, swell_hs_m=0.5, swell_tp_s=12.0), 5)
+    assert len(two) == 2 and two[0]["gamma"] == 3.3 and two[1]["tp_s"] > 8.0

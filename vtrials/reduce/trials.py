@@ -43,6 +43,7 @@ from vtrials.reduce import current as CUR
 from vtrials.reduce import logcal as LC
 from vtrials.reduce import runstats as RS
 from vtrials.reduce import speedpower as SP
+from vtrials.reduce import stawave as STA
 from vtrials.reduce.estimate import Estimate
 
 TRACKING_PREFERENCE = ("range_radar", "gnss", "acoustic_range")
@@ -290,6 +291,18 @@ def reduce_standardization(rec: Record) -> dict:
             d_r, d_r_se = wr.r_aa, wr.std
             wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
                          for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
+        # waves: STAWAVE-2 on the runs with the observed sea within ±45° of the bow (ITTC 7.5-04-01-01.1)
+        waves_used = []
+        sea = team.get("sea_observed")
+        if sea and all(team.get(k) for k in ("length_m", "beam_m", "draught_m")):
+            L_, B_, T_ = team["length_m"], team["beam_m"], team["draught_m"]
+            c_b = float(disp or team.get("displacement_m3", 0.0)) / (L_ * B_ * T_)
+            d_r, d_r_se = np.array(d_r, dtype=float), np.array(d_r_se, dtype=float)
+            for i, r in enumerate(rs):
+                raw, raw_se = STA.run_wave_resistance(sea, r["course"], vs.value, L_, B_, T_, c_b, rho=rho_w)
+                d_r[i] += raw
+                d_r_se[i] = math.hypot(d_r_se[i], raw_se)
+                waves_used.append({"r_aw": raw, "std": raw_se})
         # the runs' residual acceleration (SP.acceleration_resistance): inertia is not calm-water power
         r_acc = np.zeros(n)
         if disp and all("accel" in r for r in rs):
@@ -323,7 +336,7 @@ def reduce_standardization(rec: Record) -> dict:
         spots.append({"group": g, "runs": [r["run"] for r in rs], "n_runs": n, "method": _method_name(n),
                       "stw": _est(vs), "power_measured": _est(P_ms), "power": _est(P),
                       "rps": rps.value, "torque": torque, "thrust": thrust,
-                      "current_along_base": current_along, "wind": wind_used,
+                      "current_along_base": current_along, "wind": wind_used, "waves": waves_used,
                       "eta_D": None if eta is None else float(eta), "xi_P": xi,
                       "r_acc": [float(x) for x in np.atleast_1d(r_acc)],
                       "steady": all(r["steady"] for r in rs)})

@@ -25,6 +25,7 @@ import numpy as np
 from vtrials import __version__
 from vtrials.trials.crew import Crew
 from vtrials.errors import InputError, SimulationError
+from vtrials.instruments.sea_observation import observe_sea
 from vtrials.instruments.suite import InstrumentSet
 from vtrials.records.netcdf import atomic_path, open_record, write_groups
 from vtrials.scenario import Scenario, environment_block, sea_vessel
@@ -102,6 +103,9 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     _initial_state(sim, scn, calm)
     timings["sea_setup_s"] = time.perf_counter() - t_wall
     iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path))
+    sea = observe_sea(scn.waves, scn.head.seed)
+    if sea:  # the wave buoy's (or hindcast's) sea state, for the analysis's wave correction
+        iset.team["sea_observed"] = sea
     iset.reset()
     crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)
     try:
