@@ -138,8 +138,7 @@ def test_self_propelled_speed_loss_matches_the_added_resistance(patrol):
     for k, n in enumerate(rps):
         sim.set_shaft_order(0, n, shaft=k)
     ap = ves.autopilot
-    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), ap.gain, ap.gain / ap.integral_time,
-                      ap.gain * ap.derivative_time, 0.0)])
+    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), *ap.pid, 0.0)])
     sim.step(int(round(700.0 / DT)))
     tr = sim.truth()[:, 0, :]
     t = tr[:, sim.rec_names.index("t")]

@@ -86,8 +86,7 @@ def test_course_keeping_autopilot_recovers_heading(vessel):
     s.heading = math.radians(8.0)
     sim.set_state(0, s)
     ap = vessel.autopilot
-    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), ap.gain, ap.gain / ap.integral_time,
-                      ap.gain * ap.derivative_time)])
+    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), *ap.pid)])
     sim.step(6000)
     c = sim.truth()
     psi = np.degrees(c[:, 0, sim.rec_names.index("heading")])

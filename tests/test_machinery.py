@@ -25,8 +25,7 @@ def _straight_run(v, rps, pitch, modes=("governed", "governed"), T=400.0):
     s = sim.steady_at_order(0, (rps, rps), (pitch, pitch))
     sim.set_state(0, ShipState(u=s.u, shaft_rps=(rps, rps), pitch_ratio=(pitch, pitch), shaft_modes=modes))
     ap = v.autopilot
-    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), ap.gain, ap.gain / ap.integral_time,
-                      ap.gain * ap.derivative_time)])
+    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), *ap.pid)])
     sim.step(int(T / 0.02))
     c = sim.truth()[-int(100 / 0.02):, 0]
     col = {n: j for j, n in enumerate(sim.rec_names)}

@@ -74,7 +74,7 @@ def test_rate_helm_holds_a_rate_of_turn():
     sim = Simulator(v, 1, 0.05, record_every=1)
     sim.steady_at_order(0, (380 / 60,) * 2, (0.92, 0.92))
     ap = v.autopilot
-    gains = (ap.gain, ap.gain / ap.integral_time, ap.gain * ap.derivative_time)
+    gains = ap.pid
     for r_set in (1.5 * DEG, -0.4 * DEG):
         sim.set_helm(0, [(H.RATE, r_set, v.max_rudder, *gains, 0.0)])
         sim.clear_truth()

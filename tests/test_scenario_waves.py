@@ -56,8 +56,7 @@ def test_ship_in_the_sea3_day_moves_and_stays_finite():
     sim = Simulator(v, 1, scn.head.timestep_s)
     sim.set_state(0, s0)
     ap = scn.vessel.autopilot
-    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), ap.gain, ap.gain / ap.integral_time,
-                      ap.gain * ap.derivative_time, 0.0)])
+    sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), *ap.pid, 0.0)])
     sim.step(int(round(120.0 / scn.head.timestep_s)))
     tr = sim.truth()[:, 0, :]
     assert np.all(np.isfinite(tr))

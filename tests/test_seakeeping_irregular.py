@@ -62,8 +62,7 @@ def test_irregular_head_seas_rms(patrol, speed):
         sim.set_shaft_order(0, n, shaft=k)
     ap = ves.autopilot             # hold the heading (a free ship is course-unstable and turns beam-on)
     if speed > 0.0:
-        sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), ap.gain, ap.gain / ap.integral_time,
-                          ap.gain * ap.derivative_time, 0.0)])
+        sim.set_helm(0, [(H.HEADING, 0.0, math.radians(ap.rudder_limit_deg), *ap.pid, 0.0)])
     sim.step(int(round(2100.0 / DT)))
     tr = sim.truth()[:, 0, :]
     t = tr[:, sim.rec_names.index("t")]
@@ -112,7 +111,7 @@ def test_irregular_beam_seas_rms_roll(patrol):
     _, Jv, Je, Jd = LZ.force_jacobians(v0, start, dt)
     Jc = LZ.coriolis_jacobian(v0, start.u)
     ap = ves.autopilot
-    auto = (ap.gain, ap.gain / ap.integral_time, ap.gain * ap.derivative_time, float(ves.steering[0, 2]))
+    auto = (*ap.pid, float(ves.steering[0, 2]))
     sim = Simulator(v2, 1, dt)
     sim.set_state(0, start)
     for k, n in enumerate(start.shaft_rps):

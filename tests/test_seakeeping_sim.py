@@ -139,7 +139,7 @@ def linearised(patrol):
         _, Jv, Je, Jd = LZ.force_jacobians(v0, start, DT_C)
         Jc = LZ.coriolis_jacobian(v0, start.u)
         ap = ves.autopilot
-        auto = (ap.gain, ap.gain / ap.integral_time, ap.gain * ap.derivative_time, float(ves.steering[0, 2])) \
+        auto = (*ap.pid, float(ves.steering[0, 2])) \
             if U > 0.0 else None
         out[U] = (start, Jv, Je, Jc, Jd, auto)
     return rd, out

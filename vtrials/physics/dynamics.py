@@ -98,16 +98,6 @@ def coriolis(M, nu1, om, munk, out):
 
 
 @nb.njit(cache=True)
-def _clip(x, lim):
-    """x limited to [−lim, lim]."""
-    if x > lim:
-        return lim
-    if x < -lim:
-        return -lim
-    return x
-
-
-@nb.njit(cache=True)
 def kinematics(q, v, t, e, steer, shaftp, R, nu1, om, nu1r, c):
     """One ship's kinematics from its MuJoCo state (q = qpos, v = qvel, t time, e environment block):
     fills R (body→world), ν₁ (body-frame velocity over ground), ω, ν₁ᵣ (through the water) and the

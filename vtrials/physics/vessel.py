@@ -127,6 +127,11 @@ class Autopilot:
     derivative_time: float = num("derivative time T_d (K_d = K_p T_d)", "s", 0.0, 1e4)
     rudder_limit_deg: float = num("largest rudder the autopilot orders", "deg", 0.0, 90.0, lo_open=True)
 
+    @property
+    def pid(self) -> tuple[float, float, float]:
+        """(K_p, K_i, K_d) = (K_p, K_p/T_i, K_p T_d) of the heading controller."""
+        return self.gain, self.gain / self.integral_time, self.gain * self.derivative_time
+
 
 _SECTIONS = {"meta": Meta, "particulars": Particulars, "inertia": Inertia, "hydrostatics": Hydrostatics,
              "added_mass": AddedMass, "damping": Damping, "autopilot": Autopilot}

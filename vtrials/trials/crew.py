@@ -238,7 +238,7 @@ class Crew:
         self.names = sim.rec_names
         self.col = {n: j for j, n in enumerate(self.names)}
         ap = self.vessel.autopilot
-        self.gains = (ap.gain, ap.gain / ap.integral_time, ap.gain * ap.derivative_time)
+        self.gains = ap.pid
         self.events: list[tuple[float, int, int]] = []
         self.orders: list[tuple[float, str]] = []
         self.settings: list[tuple[float, int, float, float, int]] = []  # t, shaft, rps, pitch, mode

@@ -53,7 +53,7 @@ def twin_points(vessel, settings: list[dict], dt: float, window_s: float = 120.0
     ns = sim.ns
     ap = vessel.autopilot
     lim = min(ap.rudder_limit_deg * math.pi / 180, vessel.max_rudder)
-    gains = (ap.gain, ap.gain / ap.integral_time, ap.gain * ap.derivative_time)
+    gains = ap.pid
     for i, st in enumerate(settings):
         gov = [k for k in range(ns) if st["modes"][k] == "governed"]
         n0 = float(np.mean([st["rps"][k] for k in gov]))
