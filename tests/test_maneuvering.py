@@ -135,6 +135,30 @@ def test_drift_line_averages_the_side_dependent_push():
     assert line.tau[0] == pytest.approx(push, rel=0.2)
 
 
+def test_drift_line_with_a_side_term_for_turns():
+    """The same circles with their sides given: the side term takes the ± push, the line at s = 0 is the
+    current (the mean of both sides) with an uncertainty from its own noise only (τ beyond the side
+    term ≈ 0, so far narrower than the plain line's τ-twice), and the side term's value is the push."""
+    times = np.arange(8) * 900.0
+    cur_n = 0.2 + 1e-5 * times
+    push = 0.04
+    rng = np.random.default_rng(3)
+    sides = [1 if k % 2 == 0 else -1 for k in range(8)]
+    drifts = [Drift(Estimate(cur_n[k] + s * push + rng.normal(0, 0.005), 0.005),
+                    Estimate(-0.1 - s * push + rng.normal(0, 0.005), 0.005), np.eye(2) * 2.5e-5, "pairs")
+              for k, s in enumerate(sides)]
+    line = DriftLine(times, drifts, sides)
+    for tt in (1000.0, 4000.0):
+        dn, de = line.for_turns(tt)
+        plain, _ = line(tt)
+        assert dn.value == pytest.approx(0.2 + 1e-5 * tt, abs=0.01)
+        assert de.value == pytest.approx(-0.1, abs=0.01)
+        assert dn.std < 0.01 < push < plain.std
+    coef = line.side[0]
+    assert coef[2, 0] == pytest.approx(push, abs=0.01) and coef[2, 1] == pytest.approx(-push, abs=0.01)
+    assert DriftLine(times, drifts, [1] * 8).side is None  # one side only: no side term
+
+
 # ----------------------------------------------------------------------------------- whole trials
 @pytest.fixture(scope="module")
 def tactical(tmp_path_factory, scenarios_dir):

@@ -217,6 +217,16 @@ class GNSS(Device):
         v = kin.velocity_world()
         return np.column_stack([p[:, 0], p[:, 1], v[:, 0], v[:, 1]])
 
+    def meta(self):
+        m = super().meta()
+        # the receiver's stated horizontal accuracy per axis (1σ; data-sheet figure: the catalogue's
+        # slowly varying, multipath and white parts together), as a team has it
+        s = self.spec
+        parts = [float(s.get("gauss_markov", {}).get("sd", 0.0)), float((s.get("multipath") or {}).get("sd", 0.0)),
+                 float(s.get("noise", 0.0))]
+        m["horizontal_accuracy_m"] = math.sqrt(sum(x * x for x in parts)) * self.f
+        return m
+
     def outputs(self, t, y):
         return {"north": y[:, 0], "east": y[:, 1], "sog": np.hypot(y[:, 2], y[:, 3]),
                 "cog": _wrap2pi(np.arctan2(y[:, 3], y[:, 2]))}

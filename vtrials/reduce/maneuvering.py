@@ -79,6 +79,7 @@ class Channels:
         # with its surveyed position and the gyro / vertical-gyro attitude (IMO definitions refer to
         # the ship, and a 10-m lever arm is 10 % of a patrol vessel's transfer)
         self.lever_arm = np.asarray(rec.meta(self.tracking).get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
+        self.sigma_fix = float(rec.meta(self.tracking).get("horizontal_accuracy_m", 0.0))
         if self.heading is not None and np.any(self.lever_arm != 0.0):
             psi = np.interp(self.t, self.t_heading, self.heading)
             phi = np.interp(self.t, self.t_roll, self.roll) if self.roll is not None else 0.0 * psi
@@ -123,45 +124,69 @@ def _horizontal_offset(s, phi, theta, psi):
 
 class DriftLine:
     """Drift (north, east) [m/s] against time of day: a least-squares line through the circles' drifts
-    (a constant below four circles), with the standard error of the line and the scatter τ about it."""
+    (a constant below four circles), with the standard error of the line and the scatter τ about it.
 
-    def __init__(self, times, drifts):
+    With ``sides`` (+1 starboard, −1 port per circle) and circles of both sides, a second fit adds a
+    side term s·d_side: the wind's push on a circling ship differs between the sides (it is a mean over
+    the loop weighted by the time spent at each heading, mirrored between the sides), and the line
+    evaluated at s = 0 is the mean of both. :meth:`for_turns` gives that mean with its line SE and the
+    scatter left beyond the side term (τ_turn) once: the turning references remove the same mean drift
+    (:func:`vtrials.score.trials.drift_corrected_turns`), so the side part is no error of a turn's
+    metrics. ``__call__`` keeps the plain line and τ² twice (for runs that are not circles)."""
+
+    def __init__(self, times, drifts, sides=None):
         t = np.asarray(times, float)
         v = np.array([[d.north.value, d.east.value] for d in drifts])
         self.tm = float(t.mean())
         n = t.size
         line = n >= 4 and np.ptp(t) > 0
         A = np.column_stack([np.ones(n), t - self.tm]) if line else np.ones((n, 1))
-        coef, *_ = np.linalg.lstsq(A, v, rcond=None)
-        res = v - A @ coef
-        dof = n - A.shape[1]
-        own = np.array([[d.north.std, d.east.std] for d in drifts])
-        if dof > 0:
-            s2 = np.sum(res ** 2, axis=0) / dof
-        else:
-            s2 = np.mean(own ** 2, axis=0)
-        self.coef, self.A_inv = coef, np.linalg.pinv(A.T @ A)
-        self.s2 = s2
-        # scatter beyond the circles' own noise: the wind's push and anything else a line misses
-        self.tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - np.mean(own ** 2, axis=0), 0.0)))
+        self.own = np.array([[d.north.std, d.east.std] for d in drifts])
+        self.coef, self.A_inv, self.s2, self.tau, dof = self._fit(A, v)
         self.line = line
         self.dof = max(dof, 1)
+        self.side = None
+        if sides is not None:
+            sd = np.asarray(sides, float)
+            As = np.column_stack([A, sd])
+            if np.any(sd > 0) and np.any(sd < 0) and n - As.shape[1] >= 2 and np.linalg.matrix_rank(As) == As.shape[1]:
+                self.side = self._fit(As, v)
+
+    def _fit(self, A, v):
+        coef, *_ = np.linalg.lstsq(A, v, rcond=None)
+        res = v - A @ coef
+        dof = v.shape[0] - A.shape[1]
+        s2 = np.sum(res ** 2, axis=0) / dof if dof > 0 else np.mean(self.own ** 2, axis=0)
+        # scatter beyond the circles' own noise: the wind's push and anything else the fit misses
+        tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - np.mean(self.own ** 2, axis=0), 0.0)))
+        return coef, np.linalg.pinv(A.T @ A), s2, tau, dof
+
+    def _at(self, fit, a, tau_count: float) -> tuple[Estimate, Estimate]:
+        coef, A_inv, s2, tau, dof = fit
+        val = a @ coef
+        out = []
+        for ax in range(2):
+            var = float(a @ A_inv @ a) * s2[ax] + tau_count * tau[ax] ** 2
+            out.append(Estimate(float(val[ax]), math.sqrt(var), max(dof, 1)))
+        return out[0], out[1]
 
     def __call__(self, t: float) -> tuple[Estimate, Estimate]:
         a = np.array([1.0, t - self.tm]) if self.line else np.array([1.0])
-        val = a @ self.coef
-        out = []
-        for ax in range(2):
-            # τ² twice: the side-dependent part of the wind's push shows as scatter about the line; the
-            # part common to both sides (a downwind drift the line cannot tell from current) is taken
-            # to be of the same size
-            var = float(a @ self.A_inv @ a) * self.s2[ax] + 2.0 * self.tau[ax] ** 2
-            out.append(Estimate(float(val[ax]), math.sqrt(var), self.dof))
-        return out[0], out[1]
+        # τ² twice: the side-dependent part of the wind's push shows as scatter about the line; the
+        # part common to both sides (a downwind drift the line cannot tell from current) is taken
+        # to be of the same size
+        return self._at((self.coef, self.A_inv, self.s2, self.tau, self.dof), a, 2.0)
+
+    def for_turns(self, t: float) -> tuple[Estimate, Estimate]:
+        """The mean drift of both sides at time t, for a turn's drift correction (class doc)."""
+        if self.side is None:
+            return self(t)
+        a = np.array([1.0, t - self.tm, 0.0]) if self.line else np.array([1.0, 0.0])
+        return self._at(self.side, a, 1.0)
 
 
-def drift_model(times, drifts) -> DriftLine | None:
-    return DriftLine(times, drifts) if len(drifts) >= 2 else None
+def drift_model(times, drifts, sides=None) -> DriftLine | None:
+    return DriftLine(times, drifts, sides) if len(drifts) >= 2 else None
 
 
 def periodic_steady_window(t_heading, heading, t_execute: float, *, tol: float = 0.02,
@@ -289,7 +314,7 @@ def reduce_maneuvering(rec: Record) -> dict:
     runs = sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
     L = float(rec.team.get("length_m", math.nan))
     out_runs = []
-    drift_times, drifts = [], []
+    drift_times, drifts, drift_sides = [], [], []
     turns = []
     # turns first: their drifts serve the speed changes
     for r in runs:
@@ -313,24 +338,26 @@ def reduce_maneuvering(rec: Record) -> dict:
         if res.drift is not None:
             drift_times.append(0.5 * (r["t_execute"] + r["t_finex"]))
             drifts.append(res.drift)
+            drift_sides.append(res.turn_side)
     # The day's drift model: a straight line in time through the circles' own drifts (constant with
     # fewer than four circles). Each circle's drift also holds the wind's push on the turning ship,
     # which differs between starboard and port turns; a line through circles of both sides averages
     # that part out, and the scatter about the line (τ) is kept as a drift uncertainty.
-    model = drift_model(drift_times, drifts)
+    model = drift_model(drift_times, drifts, drift_sides)
     if model is not None and len(turns) >= 2:
         for k, d in enumerate(out_runs):
             r, res0 = next((x for x in turns if x[0]["run"] == d["run"]), (None, None))
             if r is None:
                 continue
             tm = 0.5 * (r["t_execute"] + r["t_finex"])
-            dn, de = model(tm)
+            dn, de = model.for_turns(tm)
             w = ch.window(r["t_comex"] - 5.0, r["t_finex"])
             try:
                 res = TU.turning_metrics(w["t"], w["north"], w["east"], w["heading"], r["t_execute"],
                                          t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
                                          rudder=w.get("rudder"), t_rudder=w.get("t_rudder"),
-                                         approach_s=r["t_execute"] - r["t_comex"], steady=res0.steady, drift=(dn, de))
+                                         approach_s=r["t_execute"] - r["t_comex"], steady=res0.steady, drift=(dn, de),
+                                         sigma_fix=ch.sigma_fix)
             except (ValueError, np.linalg.LinAlgError):
                 continue
             own = d.get("drift")

@@ -641,7 +641,8 @@ def _mark_time(th, psi_rel, level, after, sig, rate_guess):
 def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None, roll=None, t_roll=None,
                     rudder=None, t_rudder=None, drift="auto", approach_s: float = 60.0,
                     steady: SteadyWindow | None = None, steady_tol: float = 0.02,
-                    min_span_deg: float = 90.0, mark_window_deg: float = 10.0) -> TurningResult:
+                    min_span_deg: float = 90.0, mark_window_deg: float = 10.0,
+                    sigma_fix: float = 0.0) -> TurningResult:
     """Turning-circle metrics from recorded channels (see the module docstring for definitions).
 
     Parameters: ``t, north, east`` tracking [s, m, m]; ``heading`` gyro [rad] on ``t_heading`` (the
@@ -649,7 +650,9 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     ``rudder``/``t_rudder`` [rad, s] optional; ``drift``: 'auto' / 'pairs' / 'heading_pairs' /
     'circle' (estimated from this record), a :class:`Drift` or a (v_N, v_E) pair [m/s] (e.g. from
     :func:`vtrials.reduce.reach.interpolate_drift`), or None for no correction; ``approach_s`` [s]
-    approach window before EXECUTE.
+    approach window before EXECUTE; ``sigma_fix`` [m] the tracking system's stated accuracy per axis,
+    whose slowly varying part the residual-based σ_p cannot see: a mark's position relative to
+    EXECUTE gets 2 σ_fix² per axis (the two fixes' errors taken independent).
     """
     notes: list[str] = []
     tp, N, E = _clean(t, north, east)
@@ -729,7 +732,7 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         vE, sE_, varE, _, _ = _local_poly(tp[post], Ec[post], tq, hw, 3, sigE, min_pts=8)
         vel = np.array([sN_, sE_])
         C = np.diag([varN + var_PeN, varE + var_PeE]) + t_se ** 2 * np.outer(vel, vel) \
-            + (tq - t_execute) ** 2 * Sd
+            + (tq - t_execute) ** 2 * Sd + 2.0 * sigma_fix ** 2 * np.eye(2)
         return np.array([vN - PeN, vE - PeE]), vel, C
 
     def project(dP, C):
