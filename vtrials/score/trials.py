@@ -236,8 +236,9 @@ def drift_corrected_turns(truth: dict) -> dict:
     """Turn references on the track through the water less the trial's mean loop drift.
 
     A trials team corrects a turning circle for its drift — the track's displacement between
-    positions one loop apart (ITTC Recommended Procedure 7.5-04-02-01, Full Scale Manoeuvring Trials, turning circle
-    analysis) — which holds the current and also the wind's leeway of the circling ship; the
+    positions one loop apart (ITTC Recommended Procedure 7.5-04-02-01, Full Scale Manoeuvring
+    Trials, turning circle analysis) — which holds the current and also the wind's leeway of the
+    circling ship; the
     reduction averages it over the day's circles of both sides. The reference is taken by the same
     definition: the track through the water (current removed exactly) less the true leeway, the mean
     over the trial's turns of each one's water-track drift from 360° to 720° (the part that flips with
