@@ -67,7 +67,7 @@ def test_fit_quality_on_shipped_database(fitted):
         assert p.err_A <= 0.05 and p.err_B <= 0.05, (p.i, p.j, p.err_A, p.err_B)
         assert p.response(np.array([0.0]))[0] == pytest.approx(0.0, abs=1e-9 * np.abs(p.c).sum())
     # passivity of the assembled model: Re K(jω) positive semidefinite up to fit noise (measured:
-    # patrol51 −8e-5, kvlcc2 +5e-9 of the largest damping peak)
+    # patrol51 −2.2e-5, kvlcc2 −2.3e-6 of the largest damping peak)
     assert model.passivity_min >= -1e-3
     assert np.all(np.linalg.eigvals(model.A).real < 0.0)
 
@@ -117,10 +117,68 @@ def test_steady_sinusoid_gives_frequency_response(fitted):
     assert abs(complex(re, im) - K) <= 0.01 * abs(K)
 
 
+def test_selection_by_rao_beats_the_first_admissible_fits(fitted):
+    """The selected fits (default) against the lowest admissible orders (select="first"): the zero-speed
+    heave–pitch–roll RAOs with each model's A(ω), B(ω) against the database's own, by an independent
+    evaluation (:func:`rao.rao` on a copy of the database whose coefficients are the model's).
+    Measured worst relative error where the response is ≥ 10 % of its peak (40 frequencies, five
+    headings): patrol51 0.133 → 0.011 (beam-sea pitch, a near-cancellation of the pitch excitation and
+    the heave-coupled moment), kvlcc2 0.052 → 0.041 (pitch near its cancellation at 0.58 rad/s; the
+    passivity floor keeps it there)."""
+    import dataclasses
+
+    from vtrials.physics.seakeeping import rao as rao_mod
+    db, model = fitted
+    first = rad.fit_radiation(db, dofs=(2, 3, 4), select="first")
+    w = np.linspace(db.omega[1], db.omega[-2], 40)
+    worst = {}
+    for label, m in (("first", first), ("selected", model)):
+        K = m.response(db.omega)
+        A, B = db.A.copy(), db.B.copy()
+        for p in m.pairs:
+            A[:, p.i, p.j] = db.A_inf[p.i, p.j] + K[:, p.i, p.j].imag / db.omega
+            B[:, p.i, p.j] = K[:, p.i, p.j].real
+        dbm = dataclasses.replace(db, A=A, B=B)
+        err = 0.0
+        for beta in np.radians([0.0, 45.0, 90.0, 135.0, 180.0]):
+            ref = rao_mod.rao(db, w, beta, 0.0, (2, 3, 4))
+            got = rao_mod.rao(dbm, w, beta, 0.0, (2, 3, 4))
+            for d in (2, 3, 4):
+                if d == 3 and abs(math.sin(beta)) < 1e-9:
+                    continue
+                keep = np.abs(ref[:, d]) >= 0.1 * np.abs(ref[:, d]).max()
+                err = max(err, float(np.max(np.abs(got[keep, d] - ref[keep, d]) / np.abs(ref[keep, d]))))
+        worst[label] = err
+    assert worst["selected"] <= 0.05, worst     # issue 10's RAO tolerance
+    assert worst["selected"] < worst["first"], worst
+    assert model.passivity_min >= rad.PASSIVITY_FLOOR
+
+
+def test_fit_is_cached_and_blocks_step_alone(fitted):
+    db, model = fitted
+    assert rad.fit_radiation(db, dofs=(2, 3, 4)) is model
+    Phi, Gam = model.discretize(0.05)
+    mask = np.zeros_like(Phi, dtype=bool)
+    for k, m in model.blocks():
+        mask[k:k + m, k:k + m] = True
+    assert np.all(Phi[~mask] == 0.0)
+    # the block exponential equals the exponential of the whole system
+    from scipy.linalg import expm
+    n = model.n_states
+    M = np.zeros((n + 6, n + 6))
+    M[:n, :n] = model.A
+    M[:n, n:] = model.B
+    E = expm(M * 0.05)
+    np.testing.assert_allclose(Phi, E[:n, :n], atol=1e-12)
+    np.testing.assert_allclose(Gam, E[:n, n:], rtol=1e-9, atol=1e-12 * np.abs(Gam).max())
+
+
 def test_bad_input_is_named():
     db = load_database(ROOT / "models" / "kvlcc2" / "hydro" / "kvlcc2_hydro.nc")
     with pytest.raises(InputError, match="dofs"):
         rad.fit_radiation(db, dofs=(2, 7))
+    with pytest.raises(InputError, match="select"):
+        rad.fit_radiation(db, select="best")
     model = rad.RadiationModel((2,), (), np.zeros((0, 0)), np.zeros((0, 6)), np.zeros((6, 0)), 0.0)
     with pytest.raises(InputError, match="step"):
         model.discretize(0.0)

@@ -117,16 +117,6 @@ def test_regular_waves_time_domain_matches_rao(ship, beta_deg, speed):
         for k, d in enumerate(DOFS):
             if d == 3 and abs(math.sin(beta)) < 1e-9:
                 continue        # no roll in head or following seas (symmetry): the database's is noise
-            if d == 4 and beta_deg == 90.0 and name == "patrol51":
-                continue        # NOT MET, excluded and reported (issue 10 stays open): patrol51
-                # beam-sea pitch (≤ 0.006 rad/m) is what is left when the pitch excitation and the
-                # heave-driven coupling moment nearly cancel; it is 14 % off at 1.29 rad/s (the one
-                # checked frequency that fails; 4.3 % at 1.60, ≤ 2.4 % above). The RAO with the fitted
-                # kernels' A(ω), B(ω) equals this time domain to 4 digits, so the fit is the cause:
-                # K22's B (+1.1 %) and K42's A (−0.5 %) at 1.2–1.6 rad/s each move pitch by ~10 %, and
-                # the fits stall at 0.4–1 % (the database's A and B tails are not a causal pair: A from
-                # B by Kramers–Kronig differs by up to 2.2 % of its peak). Tighter fits tried broke
-                # kvlcc2's passivity/R² checks. kvlcc2 beam-sea pitch passes.
             if abs(fd[n, d]) < 0.10 * peak[d]:
                 continue
             checked += 1

@@ -190,10 +190,6 @@ def test_coupled_heave_roll_pitch_match_rao(patrol, linearised, beta_deg, speed,
     for d, col in ((2, "z"), (3, "roll"), (4, "pitch")):
         if abs(fd[d]) < 0.10 * peak[d] or (d == 3 and beta_deg == 180.0):
             continue                       # below 10 % of the peak (issue 10), or no roll in head seas
-        if d == 4 and beta_deg == 90.0 and omega > 1.0:
-            continue   # NOT MET, excluded and reported (issue 10 stays open): patrol51 beam-sea pitch at
-            # 1.2 rad/s (0.008 rad/m) is 6.8 % off — the radiation fit's K22/K42 error at ~1 % that
-            # test_rao.py's Cummins check pins down (its comment has the numbers)
         checked += 1
         y = r[col][last]
         bb = np.column_stack([basis, np.ones(y.size)])

@@ -10,7 +10,9 @@ zero mean about the maneuvering motion, so the memory adds no steady force to th
 speed coupling the zero-speed RAO does not have. The A∞ part of
 the radiation force is in the added-mass matrix of the dynamics' exact solve, not here.
 
-Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n), h]; states: x (n),
+Parameter block: [n_states, n_dofs, dofs(n_dofs), Φ (n×n), Γ (n × n_dofs), C (n_dofs × n), h, n_blocks,
+block starts (n_blocks + 1)]: Φ is block-diagonal (one block per fitted DOF pair) and only its blocks are
+multiplied, so a step costs Σ order² rather than n²; states: x (n),
 then scratch: n for the new x and n_dofs for the inputs (held as component states: no allocation per step).
 A simulator whose step is not h gets a non-finite force (and stops with a status) rather than a wrong memory.
 """
@@ -31,8 +33,9 @@ def pack(model, dt: float) -> tuple[np.ndarray, np.ndarray]:
     Phi, Gam = model.discretize(dt)
     dofs = np.array(model.dofs)
     n = model.n_states
+    starts = [k for k, _m in model.blocks()] + [n]
     p = np.concatenate([[n, dofs.size], dofs.astype(float), Phi.ravel(), Gam[:, dofs].ravel(),
-                        model.C[dofs].ravel(), [dt]])
+                        model.C[dofs].ravel(), [dt, len(starts) - 1], starts])
     return p.astype(np.float64), np.zeros(2 * n + dofs.size)   # x, then scratch (no allocation per step)
 
 
@@ -76,13 +79,17 @@ def radiation_kernel(p, s, env, ctx, aux, w):
             u[r] = ctx[L.NU_R + d]
     # advance: x⁺ = Φ x + Γ u (u held over the step), through the scratch part of the states
     tmp = s[n:2 * n]
-    for k in range(n):
-        acc = 0.0
-        for l in range(n):
-            acc += p[o_phi + k * n + l] * s[l]
-        for r in range(m):
-            acc += p[o_gam + k * m + r] * u[r]
-        tmp[k] = acc
+    o_blk = o_c + m * n + 1
+    for b in range(int(p[o_blk])):
+        k0 = int(p[o_blk + 1 + b])
+        k1 = int(p[o_blk + 2 + b])
+        for k in range(k0, k1):
+            acc = 0.0
+            for l in range(k0, k1):
+                acc += p[o_phi + k * n + l] * s[l]
+            for r in range(m):
+                acc += p[o_gam + k * m + r] * u[r]
+            tmp[k] = acc
     for k in range(n):
         s[k] = tmp[k]
 
