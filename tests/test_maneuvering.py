@@ -168,14 +168,22 @@ def tactical(tmp_path_factory, scenarios_dir):
 
 
 def test_tactical_diameter_and_advance_within_two_percent(tactical):
+    """Every turn's advance and tactical diameter within 2 % of the truth; their 95 % intervals miss at
+    the rate 95 % intervals should. Of 36, at most 4 may miss: with a true 95 % coverage five or more
+    misses have probability 3.6 % (binomial); intervals half as wide as the errors would miss ~nine.
+    (Requiring all 36 to cover would pass only intervals that are too wide: 0.95³⁶ = 16 %. The coverage
+    itself is measured by the 40-replicate campaign, benchmarks/results/campaign_patrol51_tactical_40.json.)"""
     out, doc = tactical
     tr = doc["trials"][0]
     turns = [r for r in tr["error"]["runs"] if r["type"] == "turn"]
     assert len(turns) == 18
+    misses = []
     for r in turns:
         for k in ("advance", "tactical_diameter"):
             assert abs(r[k]["rel_error"]) < 0.02, (r["label"], k, r[k])
-            assert r[k]["covered"], (r["label"], k, r[k])
+            if not r[k]["covered"]:
+                misses.append((r["label"], k, r[k]["error"], r[k]["half_width95"]))
+    assert len(misses) <= 4, misses
 
 
 def test_crash_stop_reach_within_three_percent(tactical):
@@ -186,6 +194,10 @@ def test_crash_stop_reach_within_three_percent(tactical):
     for r in stops:
         assert abs(r["time_to_dead_in_water"]["rel_error"]) < 0.03, r
         assert abs(r["track_reach"]["rel_error"]) < 0.03, r
+        assert r["track_reach"]["covered"], r   # the reach no longer carries the circles' leeway (+2.8 m)
+    red = {x["run"]: x for x in tr["reduced"]["runs"]}
+    for r in stops:
+        assert red[r["run"]]["drift_method"].startswith("current from the water-track log")
 
 
 def test_tactical_report_pages(tactical):

@@ -337,3 +337,65 @@ def test_reciprocal_pair_seed_example():
     uu = C.reciprocal_pair_speed(vx, vy).value
     assert (uu - U) / KNOT == pytest.approx(0.05, abs=0.0015)
     assert float(C.reciprocal_pair_bias_factor(0.1)) - 1 == pytest.approx(0.005, rel=0.01)
+
+
+# ----------------------------------------------------------------------------------- water track
+def _water_track_windows(rng, cur, headings, speeds, t, s, eps, dpsi, noise=0.1, n=120, sg=0.01):
+    """Windows of a straight run: ground velocity (with noise sg) and a water-track log's mean surge and
+    sway (scale error s, misalignment eps, n samples of white noise), read with a heading biased by dpsi."""
+    K = len(headings)
+    vg, Sg, w, vw = [], [], [], []
+    for k in range(K):
+        U, psi = speeds[k], headings[k]
+        c, sn = math.cos(psi), math.sin(psi)
+        vg.append(np.array([U * c, U * sn]) + cur(t[k]) + rng.normal(0.0, sg, 2))
+        Sg.append(np.eye(2) * sg ** 2)
+        body = (1.0 + s) * np.array([U * math.cos(eps), -U * math.sin(eps)])
+        w.append(body + rng.normal(0.0, noise / math.sqrt(n), 2))
+        vw.append(np.full(2, noise ** 2 / n))
+    return np.array(vg), np.array(Sg), np.asarray(headings) + dpsi, np.array(w), np.array(vw)
+
+
+def test_water_track_current_exact_without_errors():
+    t = np.array([0.0, 900.0, 1800.0, 2700.0, 3600.0])
+    cur = lambda tt: np.array([0.2 + 1e-5 * tt, -0.1])  # noqa: E731
+    rng = np.random.default_rng(0)
+    vg, Sg, psi, w, vw = _water_track_windows(rng, cur, [0.3, 2.0, 3.5, 5.0, 0.3], [6.0, 7.0, 5.0, 6.5, 8.0],
+                                              t, 0.0, 0.0, 0.0, noise=0.0, sg=0.0)
+    res = C.current_from_water_track(t, vg, Sg, psi, w, vw)
+    assert res.line
+    for tt in (0.0, 1234.0, 3600.0):
+        cn, ce, _ = res(tt)
+        assert cn.value == pytest.approx(cur(tt)[0], abs=1e-9) and ce.value == pytest.approx(cur(tt)[1], abs=1e-9)
+
+
+def test_water_track_current_interval_coverage():
+    """Current from 6 windows on three headings, each trial with its own draw of the log's scale error
+    (σ 0.5 %), misalignment (σ 0.5°) and heading bias (σ 0.15°) and white noise: over 400 trials the 95 %
+    ellipse of the stated covariance covers the true current at the nominal rate, and is not a
+    too-wide one (the mean squared Mahalanobis distance is near its expectation 2). Measured: coverage
+    0.953, mean distance² 1.77."""
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 3000.0, 6)
+    headings = [0.35, 0.35, 2.0, 2.0, 4.5, 4.5]
+    speeds = [6.7, 6.7, 6.7, 12.0, 6.7, 12.0]
+    true = np.array([-0.18, 0.18])
+    d2 = []
+    for _ in range(400):
+        s, eps, dpsi = rng.normal(0.0, 0.005), rng.normal(0.0, 0.5 * DEG), rng.normal(0.0, 0.15 * DEG)
+        vg, Sg, psi, w, vw = _water_track_windows(rng, lambda tt: true, headings, speeds, t, s, eps, dpsi)
+        res = C.current_from_water_track(t, vg, Sg, psi, w, vw, scale_sd=0.005, misalignment_sd=0.5 * DEG,
+                                         heading_sd=0.15 * DEG)
+        cn, ce, cov = res(1500.0)
+        e = np.array([cn.value, ce.value]) - true
+        d2.append(float(e @ np.linalg.solve(cov, e)))
+    d2 = np.array(d2)
+    cover = np.mean(d2 <= 5.991)                 # χ²₂ 95 % quantile
+    assert 0.91 <= cover <= 0.99, cover
+    assert 1.5 <= d2.mean() <= 2.6, d2.mean()
+
+
+def test_water_track_current_needs_matching_windows():
+    with pytest.raises(ValueError, match="per window"):
+        C.current_from_water_track([0.0, 1.0], np.zeros((2, 2)), np.zeros((2, 2, 2)), [0.0], np.zeros((2, 2)),
+                                   np.zeros((2, 2)))

@@ -338,3 +338,42 @@ def test_heel_rudder_and_irregular_metrics():
                      ("diameter", res.steady_diameter), ("t90", res.time_to_90)):
         assert abs(est.value - tr[key]) < 3.5 * est.std, (key, est, tr[key])
     assert abs(res.drift_angle.value) < 3.5 * res.drift_angle.std  # kinematic model: β = 0
+
+
+def test_heel_interval_carries_the_sensor_zero_accuracy():
+    """A vertical gyro's zero error (drawn once per record, σ_b stated by its maker) shifts every roll
+    sample alike: averaging does not reduce it. With ``roll_bias`` = σ_b the heel intervals cover the
+    true heel at the nominal rate over 200 records; without it they are several times too narrow."""
+    turn = Turn(T_r=20.0, T_u=20.0)
+    tp, N, E, psi = make_turn(turn)
+    rng = np.random.default_rng(7)
+    tr_ = np.arange(tp[0], tp[-1], 0.1)
+    x = tr_ - 1000.0
+    roll = np.where(x > 0, -3.0 * DEG * (1 - np.exp(-x / 15.0)), 0.0)
+    sb = 0.1 * DEG
+    hit = {True: [], False: []}
+    for _ in range(200):
+        m = roll + rng.normal(0.0, sb) + rng.normal(0.0, 0.03 * DEG, tr_.size)
+        for with_bias in (True, False):
+            res = T.turning_metrics(tp, N, E, psi, 1000.0, roll=m, t_roll=tr_, drift=(0.3, -0.2),
+                                    roll_bias=sb if with_bias else 0.0)
+            hit[with_bias].append(res.heel_steady.covers(-3.0 * DEG, 0.95))
+    assert 0.90 <= np.mean(hit[True]) <= 0.99, np.mean(hit[True])
+    assert np.mean(hit[False]) < 0.6, np.mean(hit[False])
+
+
+def test_approach_speed_from_a_given_current_not_the_drift():
+    """The circle's drift holds the wind's push on the circling ship besides the current; the approach
+    speed through the water is the ground velocity less the current. Given both, the approach speed
+    takes the current (and its covariance along the approach course)."""
+    turn = Turn(T_r=20.0, T_u=20.0)
+    cur = np.array([0.3, -0.2])
+    tp, N, E, psi = make_turn(turn, drift=tuple(cur))
+    lee = np.array([-0.05, 0.04])                   # the circles' extra drift (leeway), not in the approach
+    cov = np.diag([0.02 ** 2, 0.01 ** 2])
+    res_d = T.turning_metrics(tp, N, E, psi, 1000.0, drift=tuple(cur + lee))
+    res_c = T.turning_metrics(tp, N, E, psi, 1000.0, drift=tuple(cur + lee), current=(cur, cov))
+    u = np.array([math.cos(res_c.approach_course.value), math.sin(res_c.approach_course.value)])
+    assert res_c.approach_speed.value == pytest.approx(turn.U0, abs=1e-6)
+    assert res_d.approach_speed.value - res_c.approach_speed.value == pytest.approx(-float(lee @ u), abs=1e-9)
+    assert res_c.approach_speed.std >= math.sqrt(float(u @ cov @ u))

@@ -138,8 +138,16 @@ class Device:
         return {"chain": self.chain.drawn()}
 
     def meta(self) -> dict:
-        return {"kind": self.kind, "site": self.site_name, "surveyed_position_m": self.site.tolist(),
-                "nominal_rate_hz": float(self.spec.get("rate_hz", 0.0)), "source": self.spec.get("source", "")}
+        m = {"kind": self.kind, "site": self.site_name, "surveyed_position_m": self.site.tolist(),
+             "nominal_rate_hz": float(self.spec.get("rate_hz", 0.0)), "source": self.spec.get("source", "")}
+        if self.spec.get("latency_s"):
+            # the data sheet's (or bench-measured) delay from the measurement to its time stamp
+            m["latency_s"] = float(self.spec["latency_s"])
+        bias = self.spec.get("bias")
+        if isinstance(bias, dict) and bias.get("sd"):
+            # the stated accuracy of the zero (1σ, SI units of the channel), common to a whole record
+            m["bias_std"] = float(bias["sd"]) * self.f
+        return m
 
 
 def _wrap2pi(a):
@@ -225,6 +233,10 @@ class GNSS(Device):
         parts = [float(s.get("gauss_markov", {}).get("sd", 0.0)), float((s.get("multipath") or {}).get("sd", 0.0)),
                  float(s.get("noise", 0.0))]
         m["horizontal_accuracy_m"] = math.sqrt(sum(x * x for x in parts)) * self.f
+        # and its time correlation (data-sheet / survey knowledge of DGPS error: slow wander, multipath),
+        # per axis as (sd [m], correlation time [s]) pairs of exponentially correlated parts
+        m["correlated_errors"] = [[float(p["sd"]) * self.f, float(p["tau_s"])]
+                                  for p in (s.get("gauss_markov"), s.get("multipath")) if p and p.get("sd")]
         return m
 
     def outputs(self, t, y):
@@ -558,6 +570,16 @@ class DopplerLog(Device):
 
     def drawn(self):
         return {"misalignment_rad": self.eps, "chain": self.chain.drawn()}
+
+    def meta(self):
+        m = super().meta()
+        # the maker's / installer's stated accuracy (1σ), as a team has it: scale, white noise per
+        # sample, alignment of the transducer about the vertical
+        s = self.spec
+        m.update({"scale_accuracy": float((s.get("scale") or {}).get("sd", 0.0)),
+                  "noise_mps": float(s.get("noise", 0.0)) * self.f,
+                  "misalignment_accuracy_rad": float(s.get("misalignment_deg", 0.0)) * DEG})
+        return m
 
 
 # ------------------------------------------------------------------------------------ attitude, IMU

@@ -44,8 +44,14 @@ def record_groups(iset, t_end: float, events: list[tuple[float, int, int]],
         t, ch = iset.readings(name)
         keep = (t <= t_end) & (t >= t_start)
         variables = {c: (ch[c][keep], units, long) for c, (units, long) in dev.channels.items()}
+        attrs = dev.meta()
+        clk = iset.clocks.get(name)
+        if clk is not None:
+            # the logger clock's stated accuracy (what the team knows of its time stamps): offset and
+            # drift standard deviations, from its synchronisation at t_ref
+            attrs.update(clock_offset_sd_s=clk.sd, clock_drift_ppm_sd=clk.drift_ppm_sd, clock_t_ref_s=clk.t_ref)
         groups[name] = {"time": t[keep], "variables": variables,
-                        "attrs": {k: _json_attr(v) for k, v in dev.meta().items()}}
+                        "attrs": {k: _json_attr(v) for k, v in attrs.items()}}
     ev = sorted(events)
     groups["_events"] = {"time": np.array([e[0] for e in ev]),
                          "variables": {"run": (np.array([e[1] for e in ev], float), "1", "run number"),

@@ -688,3 +688,89 @@ def reciprocal_pair_bias_factor(c_prime):
     """U_u/U = √(1 + C′²) (seed 000 eq. 4–6; exact)."""
     c = np.asarray(c_prime, dtype=float)
     return np.sqrt(1.0 + c * c)
+
+
+# ----------------------------------------------------------------------------------- water track
+@dataclasses.dataclass(frozen=True)
+class WaterTrackCurrent:
+    """The current c(t) = a + b (t − t_ref) [m/s, north and east] from straight windows where both the
+    ground velocity (tracking) and the velocity through the water (a water-track log) are measured.
+
+    ``coef`` (2, 2): rows (a, b), columns (north, east) (b = 0 for a constant); ``cov_coef`` the
+    covariance of (a_N, a_E[, b_N, b_E]) (generalised least squares with the log's systematic errors
+    correlating the windows); ``birge``: the windows' χ²/dof against that covariance (when above 1 it
+    has scaled ``cov_coef``)."""
+
+    coef: np.ndarray
+    t_ref: float
+    line: bool
+    n_windows: int
+    cov_coef: np.ndarray
+    birge: float
+
+    def __call__(self, t: float) -> tuple[Estimate, Estimate, np.ndarray]:
+        """(north, east, covariance (2, 2)) at time of day t [s]."""
+        X = np.eye(2) if not self.line else np.hstack([np.eye(2), (t - self.t_ref) * np.eye(2)])
+        val = self.coef[0] + (self.coef[1] * (t - self.t_ref) if self.line else 0.0)
+        cov = X @ self.cov_coef @ X.T
+        return Estimate(float(val[0]), math.sqrt(cov[0, 0])), Estimate(float(val[1]), math.sqrt(cov[1, 1])), cov
+
+
+def _rot(psi):
+    c, s = np.cos(psi), np.sin(psi)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def current_from_water_track(t, v_ground, cov_ground, heading, v_water, var_water, *, scale_sd: float = 0.0,
+                             misalignment_sd: float = 0.0, heading_sd: float = 0.0) -> WaterTrackCurrent:
+    """Current from K straight windows: c_k = V_G,k − R(ψ_k) w_k, the ground velocity less the velocity
+    through the water turned from body to earth axes (a Doppler log in water-track mode beside a GNSS:
+    the set and drift a navigator reads off the two). Inputs per window: mid-time ``t`` (K,) [s],
+    ``v_ground`` (K, 2) north/east [m/s] with covariance ``cov_ground`` (K, 2, 2), gyro ``heading`` (K,)
+    [rad], the log's mean surge/sway ``v_water`` (K, 2) [m/s] with variances ``var_water`` (K, 2).
+
+    Errors: per window the ground velocity's and the log's noise; common to all windows (one draw per
+    trial, not reduced by averaging) the log's scale error (relative sd ``scale_sd``), its misalignment
+    about the vertical (``misalignment_sd`` [rad]) and the heading's bias (``heading_sd`` [rad]): to first
+    order c_k changes by −R(ψ_k)(s + (ε + δψ) J) w_k, which correlates the windows (the correlation is
+    what makes the log's errors on windows of different headings look like scatter). The current is a
+    line in time per axis from four windows spanning at least 10 min (else a constant), fitted by
+    generalised least squares with that covariance; χ²/dof above 1 (a current changing within the day in
+    a way a line does not follow) scales the result's covariance up (Birge ratio).
+    """
+    t = np.asarray(t, float)
+    vg = np.asarray(v_ground, float).reshape(-1, 2)
+    Sg = np.asarray(cov_ground, float).reshape(-1, 2, 2)
+    psi = np.asarray(heading, float)
+    w = np.asarray(v_water, float).reshape(-1, 2)
+    vw = np.asarray(var_water, float).reshape(-1, 2)
+    K = t.size
+    if not (vg.shape[0] == Sg.shape[0] == psi.size == w.shape[0] == vw.shape[0] == K) or K == 0:
+        raise ValueError("one ground velocity, covariance, heading, water velocity and variance per window")
+    R = _rot(psi).reshape(K, 2, 2)
+    ww = np.einsum("kij,kj->ki", R, w)
+    y = (vg - ww).reshape(-1)                                   # (2K,): c_N,0, c_E,0, c_N,1, ...
+    V = np.zeros((2 * K, 2 * K))
+    for k in range(K):
+        V[2 * k:2 * k + 2, 2 * k:2 * k + 2] = Sg[k] + R[k] @ np.diag(vw[k]) @ R[k].T
+    J = np.array([[0.0, -1.0], [1.0, 0.0]])
+    G = np.column_stack([ww.reshape(-1), np.einsum("kij,jl,kl->ki", R, J, w).reshape(-1)])
+    V += G @ np.diag([scale_sd ** 2, misalignment_sd ** 2 + heading_sd ** 2]) @ G.T
+    V += 1e-14 * np.eye(2 * K)
+    line = K >= 4 and float(t.max() - t.min()) >= 600.0
+    t_ref = float(np.mean(t))
+    X = np.tile(np.eye(2), (K, 1))
+    if line:
+        X = np.hstack([X, np.kron((t - t_ref)[:, None], np.eye(2))])
+    Vi = np.linalg.inv(V)
+    cov_b = np.linalg.inv(X.T @ Vi @ X)
+    beta = cov_b @ (X.T @ Vi @ y)
+    r = y - X @ beta
+    dof = 2 * K - X.shape[1]
+    birge = float(r @ Vi @ r) / dof if dof > 0 else 1.0
+    cov_b = cov_b * max(1.0, birge)
+    coef = np.zeros((2, 2))
+    coef[0] = beta[:2]
+    if line:
+        coef[1] = beta[2:]
+    return WaterTrackCurrent(coef, t_ref, line, K, cov_b, birge)

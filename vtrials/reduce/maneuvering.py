@@ -28,9 +28,11 @@ import math
 import numpy as np
 
 from vtrials.records.netcdf import Record
+from vtrials.reduce import current as CU
 from vtrials.reduce import gyro as GY
 from vtrials.reduce import imo as IMO
 from vtrials.reduce import reach as RE
+from vtrials.reduce import series as SE
 from vtrials.reduce import spiral as SPI
 from vtrials.reduce import turning as TU
 from vtrials.reduce import zigzag as ZZ
@@ -57,11 +59,27 @@ class Channels:
         t, n = rec.channel(self.tracking, "north")
         _, e = rec.channel(self.tracking, "east")
         ok = np.isfinite(n) & np.isfinite(e)
-        self.t, self.north, self.east = t[ok], n[ok], e[ok]
+        # time stamps back to the instant measured: less each instrument's stated latency
+        lag = float(rec.meta(self.tracking).get("latency_s", 0.0))
+        self.t, self.north, self.east = t[ok] - lag, n[ok], e[ok]
         g = k.get("heading", [None])[0]
         self.t_heading, self.heading = rec.channel(g, "heading") if g else (None, None)
+        if g:
+            self.t_heading = self.t_heading - float(rec.meta(g).get("latency_s", 0.0))
         gm = rec.meta(g) if g else {}
         self.gyro_drift = (float(gm.get("drift_std_rad", 0.0)), float(gm.get("drift_tau_s", 1.0)))
+        self.gyro_bias = float(gm.get("bias_std", 0.0))
+        # a water-track log (Doppler): surge and sway through the water, with its stated accuracy
+        dl = k.get("doppler_log", [None])[0]
+        self.t_water = self.water = None
+        if dl:
+            tw, uw = rec.channel(dl, "u")
+            _, vw = rec.channel(dl, "v")
+            ok = np.isfinite(uw) & np.isfinite(vw)
+            self.t_water, self.water = tw[ok], np.column_stack([uw[ok], vw[ok]])
+            dm = rec.meta(dl)
+            self.water_accuracy = (float(dm.get("scale_accuracy", 0.0)), float(dm.get("noise_mps", 0.0)),
+                                   float(dm.get("misalignment_accuracy_rad", 0.0)))
         self.gyro_resolution = float(gm.get("resolution_rad", 0.0))
         if self.heading is not None:
             self.heading = np.unwrap(self.heading)
@@ -74,12 +92,17 @@ class Channels:
                                                   float(gm["corrector_latitude_rad"]))
         a = k.get("attitude", [None])[0]
         self.t_roll, self.roll = rec.channel(a, "roll") if a else (None, None)
+        self.roll_bias = float(rec.meta(a).get("bias_std", 0.0)) if a else 0.0
         self.t_pitch, self.pitch = rec.channel(a, "pitch") if a else (None, None)
         # the fixes are of the antenna: move them to the ship's reference point (midship, waterline)
         # with its surveyed position and the gyro / vertical-gyro attitude (IMO definitions refer to
         # the ship, and a 10-m lever arm is 10 % of a patrol vessel's transfer)
         self.lever_arm = np.asarray(rec.meta(self.tracking).get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
         self.sigma_fix = float(rec.meta(self.tracking).get("horizontal_accuracy_m", 0.0))
+        self.fix_errors = [tuple(x) for x in rec.meta(self.tracking).get("correlated_errors", [])]
+        tm = rec.meta(self.tracking)
+        self._clock = (float(tm.get("clock_offset_sd_s", 0.0)), float(tm.get("clock_drift_ppm_sd", 0.0)),
+                       float(tm.get("clock_t_ref_s", 0.0)))
         if self.heading is not None and np.any(self.lever_arm != 0.0):
             psi = np.interp(self.t, self.t_heading, self.heading)
             phi = np.interp(self.t, self.t_roll, self.roll) if self.roll is not None else 0.0 * psi
@@ -97,6 +120,12 @@ class Channels:
             self.rudder = np.mean(vals, axis=0)
         else:
             self.t_rudder, self.rudder = None, None
+
+    def timing_sd(self, t: float) -> float:
+        """Standard uncertainty [s] of the tracking's time stamps at time t against the run log's
+        times: its logger clock's stated offset and drift since synchronisation."""
+        sd, ppm, t_ref = self._clock
+        return math.hypot(sd, ppm * 1e-6 * (t - t_ref))
 
     def window(self, t0: float, t1: float):
         m = (self.t >= t0) & (self.t <= t1)
@@ -177,12 +206,58 @@ class DriftLine:
         # to be of the same size
         return self._at((self.coef, self.A_inv, self.s2, self.tau, self.dof), a, 2.0)
 
+    def mean_of_sides(self, t: float) -> tuple[Estimate, Estimate]:
+        """The mean drift of both sides at time t with the line's standard error only: the estimate of
+        the day's drift itself (no scatter of single circles about it)."""
+        if self.side is None:
+            a = np.array([1.0, t - self.tm]) if self.line else np.array([1.0])
+            return self._at((self.coef, self.A_inv, self.s2, self.tau, self.dof), a, 0.0)
+        a = np.array([1.0, t - self.tm, 0.0]) if self.line else np.array([1.0, 0.0])
+        return self._at(self.side, a, 0.0)
+
     def for_turns(self, t: float) -> tuple[Estimate, Estimate]:
         """The mean drift of both sides at time t, for a turn's drift correction (class doc)."""
         if self.side is None:
             return self(t)
         a = np.array([1.0, t - self.tm, 0.0]) if self.line else np.array([1.0, 0.0])
         return self._at(self.side, a, 1.0)
+
+
+def water_track_current(ch: Channels, runs: list[dict], min_window_s: float = 20.0) -> CU.WaterTrackCurrent | None:
+    """The day's current from the runs' straight approaches (COMEX to EXECUTE): the tracking's ground
+    velocity less the water-track log's velocity turned by the gyro heading
+    (:func:`vtrials.reduce.current.current_from_water_track`). None without a water-track log or with
+    fewer than two usable approaches. Unlike the drift of the turning circles it holds no leeway: it is
+    the current alone, which a straight run's track through the water is corrected for.
+
+    Ground velocity per window: the fixes' least-squares slope, its variance from the residuals plus
+    the effect of the receiver's time-correlated errors (:func:`vtrials.reduce.series.slope_variance`).
+    """
+    if ch.water is None:
+        return None
+    scale_sd, noise, mis_sd = ch.water_accuracy
+    rows = []
+    for r in runs:
+        t0, t1 = r.get("t_comex"), r.get("t_execute")
+        if t0 is None or t1 is None or t1 - t0 < min_window_s:
+            continue
+        m = (ch.t >= t0) & (ch.t <= t1)
+        mh = (ch.t_heading >= t0) & (ch.t_heading <= t1)
+        mw = (ch.t_water >= t0) & (ch.t_water <= t1)
+        if np.count_nonzero(m) < 10 or np.count_nonzero(mw) < 10 or np.count_nonzero(mh) < 3:
+            continue
+        vn, ve = _rate(ch.t[m], ch.north[m]), _rate(ch.t[m], ch.east[m])
+        slow = SE.slope_variance(ch.t[m], ch.fix_errors)
+        a = ch.heading[mh]
+        psi = math.atan2(float(np.mean(np.sin(a))), float(np.mean(np.cos(a))))
+        nw = np.count_nonzero(mw)
+        rows.append((0.5 * (t0 + t1), (vn.value, ve.value), np.diag([vn.std ** 2 + slow, ve.std ** 2 + slow]), psi,
+                     ch.water[mw].mean(axis=0), np.full(2, noise ** 2 / nw)))
+    if len(rows) < 2:
+        return None
+    t, vg, Sg, psi, w, vw = (np.array([row[k] for row in rows]) for k in range(6))
+    return CU.current_from_water_track(t, vg, Sg, psi, w, vw, scale_sd=scale_sd, misalignment_sd=mis_sd,
+                                       heading_sd=ch.gyro_bias)
 
 
 def drift_model(times, drifts, sides=None) -> DriftLine | None:
@@ -316,6 +391,14 @@ def reduce_maneuvering(rec: Record) -> dict:
     out_runs = []
     drift_times, drifts, drift_sides = [], [], []
     turns = []
+    current = water_track_current(ch, runs)
+
+    def current_at(t: float):
+        if current is None:
+            return None
+        cn, ce, cov = current(t)
+        return np.array([cn.value, ce.value]), cov
+
     # turns first: their drifts serve the speed changes
     for r in runs:
         if r["maneuver"].get("type") not in ("turn",):
@@ -327,7 +410,8 @@ def reduce_maneuvering(rec: Record) -> dict:
             res = TU.turning_metrics(w["t"], w["north"], w["east"], w["heading"], r["t_execute"],
                                      t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
                                      rudder=w.get("rudder"), t_rudder=w.get("t_rudder"), approach_s=approach,
-                                     steady=sw)
+                                     steady=sw, current=current_at(r["t_execute"]), roll_bias=ch.roll_bias,
+                                     fix_errors=ch.fix_errors, timing_sd=ch.timing_sd(r["t_execute"]))
         except (ValueError, np.linalg.LinAlgError) as exc:
             out_runs.append({"run": r["run"], "type": "turn", "error": str(exc)})
             continue
@@ -357,13 +441,17 @@ def reduce_maneuvering(rec: Record) -> dict:
                                          t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
                                          rudder=w.get("rudder"), t_rudder=w.get("t_rudder"),
                                          approach_s=r["t_execute"] - r["t_comex"], steady=res0.steady, drift=(dn, de),
-                                         sigma_fix=ch.sigma_fix)
+                                         sigma_fix=ch.sigma_fix, current=current_at(r["t_execute"]),
+                                         roll_bias=ch.roll_bias, fix_errors=ch.fix_errors,
+                                         timing_sd=ch.timing_sd(r["t_execute"]))
             except (ValueError, np.linalg.LinAlgError):
                 continue
             own = d.get("drift")
             d.update(_clean(res.to_dict()))
             d["drift_own_circle"] = own
             d["drift_method"] = "day's drift line through all circles (both sides)"
+            mn, me = model.mean_of_sides(tm)
+            d["drift_of_day"] = {"north": _clean(mn), "east": _clean(me)}
     for r in runs:
         kind = r["maneuver"].get("type")
         p = r["maneuver"]
@@ -376,12 +464,21 @@ def reduce_maneuvering(rec: Record) -> dict:
         try:
             if kind == "speed_change":
                 drift = None
-                if model is not None:
-                    dn, de = model(0.5 * (r["t_execute"] + r["t_finex"]))
+                tm = 0.5 * (r["t_execute"] + r["t_finex"])
+                if current is not None:
+                    # a straight run's track through the water: the ground track less the current (the
+                    # circles' drift would also remove the wind's push on a circling ship, absent here)
+                    cn, ce, cov = current(tm)
+                    drift = RE.InterpolatedDrift(cn, ce, False, (0.0, 0.0), cov)
+                    d["drift_method"] = "current from the water-track log against the tracking (straight approaches)"
+                elif model is not None:
+                    dn, de = model(tm)
                     drift = RE.InterpolatedDrift(dn, de, False, model.tau)
+                    d["drift_method"] = "day's drift line through all circles (both sides)"
                 res = RE.reach_analysis(w["t"], w["north"], w["east"], r["t_execute"], heading=w["heading"],
                                         t_heading=w["t_heading"], drift=drift, approach_s=approach,
-                                        seed=int(r["run"]))
+                                        seed=int(r["run"]), fix_errors=ch.fix_errors,
+                                        timing_sd=ch.timing_sd(r["t_execute"]))
                 d.update(_clean(res.to_dict()))
                 cv = res.curve
                 if cv:
@@ -466,7 +563,12 @@ def reduce_maneuvering(rec: Record) -> dict:
             breakdown.append(_clean({"speed": g.speed, "side": g.side, "rudder": g.rudder, "rate": g.rate,
                                      "rate_std": g.rate_std, "breakdown": g.breakdown,
                                      "breakdown_rudder": g.breakdown_rudder}))
+    wt = None
+    if current is not None:
+        wt = {"coef": current.coef.tolist(), "t_ref": current.t_ref, "linear": current.line,
+              "windows": current.n_windows, "birge": current.birge, "cov_coef": current.cov_coef.tolist()}
     return {"kind": "maneuvering", "tracking": ch.tracking, "runs": out_runs, "rate_vs_rudder": breakdown,
+            "current_water_track": wt,
             "drift_circles": {"times": drift_times, "drifts": [_clean(x) for x in drifts],
                               "line": None if model is None else {"coef": model.coef.tolist(), "t_ref": model.tm,
                                                                   "tau": list(model.tau), "linear": model.line}},

@@ -71,7 +71,7 @@ from scipy import sparse
 from scipy.interpolate import BSpline
 
 from vtrials.reduce.estimate import Estimate
-from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_inflation as _ar1_inflation
+from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_inflation as _ar1_inflation, slope_variance
 
 
 # --------------------------------------------------------------------------------------------- helpers
@@ -96,6 +96,7 @@ class InterpolatedDrift:
     east: Estimate
     extrapolated: bool
     process_std: tuple[float, float]  # unmodelled drift variability τ per axis [m/s]
+    full_cov: np.ndarray | None = None  # (2, 2) when the axes' errors are correlated
 
     def __iter__(self):
         return iter((self.north, self.east))
@@ -106,6 +107,8 @@ class InterpolatedDrift:
 
     @property
     def cov(self) -> np.ndarray:
+        if self.full_cov is not None:
+            return np.asarray(self.full_cov, float)
         return np.diag([self.north.std ** 2, self.east.std ** 2])
 
 
@@ -333,6 +336,7 @@ def _metrics(tg, s, y, vs, vy, dpsi_g, U0, tail_t, s_tail, y_tail, band_fraction
             k = int(idx[0])
             a = -g[k] / (g[k + 1] - g[k])
             out["t90"] = tg[k] + a * (tg[k + 1] - tg[k])
+            out["a90"] = float((U[k + 1] - U[k]) / (tg[k + 1] - tg[k]))
     return out
 
 
@@ -340,7 +344,7 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
                    approach_s: float = 60.0, tail_fraction: float = 0.1, tail_min_s: float = 20.0,
                    band_fraction: float = 0.02, n_boot: int = 200, block: int = 1, seed: int = 0,
                    knot_dt: float | None = None, grid_dt: float | None = None,
-                   gamma: float = 10.0) -> ReachResult:
+                   gamma: float = 10.0, fix_errors=(), timing_sd: float = 0.0) -> ReachResult:
     """Reduce an acceleration / deceleration / stopping run (see the module docstring).
 
     ``t, north, east`` [s, m, m] tracking; ``t_execute`` [s]; ``heading`` [rad] on ``t_heading``
@@ -350,13 +354,20 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
     ``n_boot`` bootstrap replicates (0: only the analytic course/drift terms are reported);
     ``block`` moving-block length [samples]; ``seed`` RNG seed; ``knot_dt`` [s] knot spacing of the
     penalised spline (default 4 sample intervals); ``grid_dt`` [s] evaluation grid; ``gamma`` the
-    smoothing inflation of :class:`PSpline`.
+    smoothing inflation of :class:`PSpline`; ``fix_errors`` the tracking's time-correlated errors per
+    axis, (sd [m], τ [s]) pairs (e.g. a DGPS's slow wander and multipath): the approach and terminal
+    speeds, slopes over a window, carry their effect (:func:`vtrials.reduce.series.slope_variance`),
+    which the residuals and the bootstrap of white residuals do not see, and the 90 % time the part
+    of it that moves the 90 % level. Speeds through the water also carry the drift's uncertainty.
+    ``timing_sd`` [s]: the standard uncertainty of the tracking's time stamps against the EXECUTE
+    time (its logger clock's offset and drift): times from EXECUTE carry it, and reaches carry the
+    approach speed times it (the EXECUTE position moves along the track).
     """
     notes: list[str] = []
     tp, N, E = _clean(t, north, east)
     if drift is not None:
         (dn, sdn), (de, sde) = _drift_components(drift)
-        SD = np.diag([sdn ** 2, sde ** 2])
+        SD = np.asarray(drift.cov, float) if hasattr(drift, "cov") else np.diag([sdn ** 2, sde ** 2])
         N = N - dn * (tp - t_execute)
         E = E - de * (tp - t_execute)
     else:
@@ -387,7 +398,9 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
     uvec = np.array([math.cos(psi0), math.sin(psi0)])
     nvec = np.array([-math.sin(psi0), math.cos(psi0)])
     U0 = float(uvec @ [bN, bE])
-    U0_se = math.sqrt((uvec[0] * sbN) ** 2 + (uvec[1] * sbE) ** 2)
+    var_fix_app = slope_variance(tp[ma], fix_errors)
+    var_drift_u = float(uvec @ SD @ uvec)
+    U0_se = math.sqrt((uvec[0] * sbN) ** 2 + (uvec[1] * sbE) ** 2 + var_fix_app + var_drift_u)
 
     t_end = float(tp[-1])
     mfit = tp >= t_execute - approach_s
@@ -495,8 +508,10 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         return float(np.std(v, ddof=1)) if len(v) >= 2 else 0.0
 
     dof = None
+    var_fix_tail = slope_variance(tf[tail], fix_errors)
     res = ReachResult(approach_course=Estimate(psi0, psi0_se), approach_speed=Estimate(U0, U0_se),
-                      terminal_speed=Estimate(base["UT"], bstd("UT")), terminal_reached=terminal_reached,
+                      terminal_speed=Estimate(base["UT"], math.sqrt(bstd("UT") ** 2 + var_fix_tail + var_drift_u)),
+                      terminal_reached=terminal_reached,
                       band=base["band"], dead_in_water="t_diw" in base, sigma_position=(sig_s, sig_y),
                       n_boot=n_boot, notes=notes)
     if "t_diw" in base:
@@ -504,13 +519,15 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         el = td - t_execute
         sD_u = math.sqrt(float(uvec @ SD @ uvec))
         sD_n = math.sqrt(float(nvec @ SD @ nvec))
-        sd_t = math.hypot(bstd("t_diw"), sD_u / max(abs(base["udot_diw"]), 1e-9))
+        sd_t = math.sqrt(bstd("t_diw") ** 2 + (sD_u / max(abs(base["udot_diw"]), 1e-9)) ** 2 + timing_sd ** 2)
+        s_clk = U0 * timing_sd
         s_d, y_d = base["s_diw"], base["y_diw"]
         res.time_to_dead_in_water = Estimate(el, sd_t, dof)
-        res.head_reach = Estimate(s_d, math.sqrt(bstd("s_diw") ** 2 + (y_d * psi0_se) ** 2 + (el * sD_u) ** 2))
+        res.head_reach = Estimate(s_d, math.sqrt(bstd("s_diw") ** 2 + (y_d * psi0_se) ** 2 + (el * sD_u) ** 2
+                                                 + s_clk ** 2))
         res.lateral_deviation = Estimate(y_d, math.sqrt(bstd("y_diw") ** 2 + (s_d * psi0_se) ** 2
                                                         + (el * sD_n) ** 2))
-        res.track_reach = Estimate(base["path_diw"], math.sqrt(bstd("path_diw") ** 2 + (el * sD_u) ** 2))
+        res.track_reach = Estimate(base["path_diw"], math.sqrt(bstd("path_diw") ** 2 + (el * sD_u) ** 2 + s_clk ** 2))
         n_ok = len(reps["t_diw"])
         if n_boot and n_ok < 0.9 * n_boot:
             notes.append(f"DIW found in only {n_ok} of {n_boot} bootstrap replicates")
@@ -522,12 +539,17 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         te = base["t_term"]
         el = te - t_execute
         sD_u = math.sqrt(float(uvec @ SD @ uvec))
-        res.time_to_terminal_speed = Estimate(el, bstd("t_term"))
+        res.time_to_terminal_speed = Estimate(el, math.hypot(bstd("t_term"), timing_sd))
         res.reach_at_terminal = Estimate(base["s_term"], math.sqrt(bstd("s_term") ** 2 + (el * sD_u) ** 2))
         res.track_distance_at_terminal = Estimate(base["path_term"],
                                                   math.sqrt(bstd("path_term") ** 2 + (el * sD_u) ** 2))
     if base.get("t90") is not None:
-        res.time_to_90_percent = Estimate(base["t90"] - t_execute, bstd("t90"))
+        # the 90 % level U0 + 0.9 (UT − U0) moves with the two speeds' window errors (a common drift
+        # error cancels in the difference); the crossing moves by that over the acceleration there
+        lvl = 0.01 * var_fix_app + 0.81 * var_fix_tail
+        a90 = abs(base.get("a90", 0.0))
+        extra = lvl / a90 ** 2 if a90 > 0.0 else 0.0
+        res.time_to_90_percent = Estimate(base["t90"] - t_execute, math.sqrt(bstd("t90") ** 2 + extra + timing_sd ** 2))
     Ug = np.array(Ug) if Ug else np.zeros((0, len(tg)))
     res.curve = {"t": tg, "reach": base["s"], "lateral": base["y"], "speed": base["U"], "surge": base["u"],
                  "speed_std": Ug.std(axis=0, ddof=1) if len(Ug) >= 2 else np.zeros(len(tg))}

@@ -63,3 +63,22 @@ def ar1_inflation(resid) -> float:
         return 1.0
     rho = min(max(float(r[1:] @ r[:-1]) / den, 0.0), 0.95)
     return math.sqrt((1 + rho) / (1 - rho))
+
+
+def slope_variance(t, components) -> float:
+    """Variance [(unit/s)²] of a least-squares slope over the samples at ``t`` [s] from errors that are
+    correlated in time: ``components`` (sd, τ) pairs of exponentially correlated (Gauss–Markov)
+    errors, cov(e_i, e_j) = Σ sd² exp(−|t_i − t_j|/τ). Var(b) = wᵀ C w with the OLS weights
+    w_i = (t_i − t̄)/Σ(t − t̄)². A slowly wandering error (τ much longer than the window) moves the
+    slope by about sd·√(2/(τT)), which residual-based standard errors do not see."""
+    t = np.asarray(t, float)
+    if t.size < 2 or not components:
+        return 0.0
+    x = t - t.mean()
+    sxx = float(x @ x)
+    if sxx <= 0.0:
+        return math.inf
+    w = x / sxx
+    dt = np.abs(t[:, None] - t[None, :])
+    C = sum(float(sd) ** 2 * np.exp(-dt / float(tau)) for sd, tau in components if sd > 0.0 and tau > 0.0)
+    return float(w @ C @ w) if not np.isscalar(C) else 0.0

@@ -77,7 +77,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from vtrials.reduce.estimate import Estimate
-from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation
+from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation, slope_variance
 
 TWO_PI = 2.0 * math.pi
 
@@ -642,7 +642,8 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
                     rudder=None, t_rudder=None, drift="auto", approach_s: float = 60.0,
                     steady: SteadyWindow | None = None, steady_tol: float = 0.02,
                     min_span_deg: float = 90.0, mark_window_deg: float = 10.0,
-                    sigma_fix: float = 0.0) -> TurningResult:
+                    sigma_fix: float = 0.0, current=None, roll_bias: float = 0.0, fix_errors=(),
+                    timing_sd: float = 0.0) -> TurningResult:
     """Turning-circle metrics from recorded channels (see the module docstring for definitions).
 
     Parameters: ``t, north, east`` tracking [s, m, m]; ``heading`` gyro [rad] on ``t_heading`` (the
@@ -652,7 +653,16 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     :func:`vtrials.reduce.reach.interpolate_drift`), or None for no correction; ``approach_s`` [s]
     approach window before EXECUTE; ``sigma_fix`` [m] the tracking system's stated accuracy per axis,
     whose slowly varying part the residual-based σ_p cannot see: a mark's position relative to
-    EXECUTE gets 2 σ_fix² per axis (the two fixes' errors taken independent).
+    EXECUTE gets 2 σ_fix² per axis (the two fixes' errors taken independent) unless ``fix_errors``
+    gives the error's time correlation (then the variance of its change over the time from EXECUTE to the
+    mark). ``current``: (vector
+    (2,) north/east [m/s], covariance (2, 2)) of the current, for the approach speed through the water
+    (else the drift is taken for it); ``roll_bias`` [rad] the roll sensor's stated zero accuracy (1σ),
+    added to the heel estimates' variance (it is common to the record: averaging does not reduce it);
+    ``fix_errors`` the tracking's time-correlated errors per axis, (sd [m], τ [s]) pairs, for the
+    approach velocity's variance (:func:`vtrials.reduce.series.slope_variance`); ``timing_sd`` [s] the
+    standard uncertainty of each logger's time stamps against the run log's (clock offset and drift):
+    a mark's time against the fixes carries two of them, the EXECUTE point one.
     """
     notes: list[str] = []
     tp, N, E = _clean(t, north, east)
@@ -685,7 +695,7 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     u = np.array([math.cos(psi0), math.sin(psi0)])
     nvec = np.array([-math.sin(psi0), math.cos(psi0)])
     v_app = np.array([bN, bE])
-    var_app = (sbN * u[0]) ** 2 + (sbE * u[1]) ** 2
+    var_app = (sbN * u[0]) ** 2 + (sbE * u[1]) ** 2 + slope_variance(tp[mp], fix_errors)
 
     # steady window and drift
     sw = steady or steady_window(th, psi, t_execute, tol=steady_tol, min_span_deg=min_span_deg,
@@ -713,15 +723,31 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     else:
         Nc, Ec = N, E
         Sd = np.zeros((2, 2))
-    # approach speed through the water: ground velocity of the approach minus the drift (current)
-    v_w = v_app - (drift_obj.vector if drift_obj is not None else 0.0)
-    app_speed = Estimate(float(v_w @ u), math.sqrt(var_app + float(u @ Sd @ u)))
+    # approach speed through the water: ground velocity of the approach minus the current — the
+    # current itself when the caller has it (``current``: (vector, covariance), e.g. from a water-track
+    # log), else the drift, which on a circle also holds the wind's push on the turning ship
+    if current is not None:
+        c_vec, c_cov = np.asarray(current[0], float), np.asarray(current[1], float)
+    elif drift_obj is not None:
+        c_vec, c_cov = drift_obj.vector, Sd
+    else:
+        c_vec, c_cov = np.zeros(2), np.zeros((2, 2))
+    v_w = v_app - c_vec
+    app_speed = Estimate(float(v_w @ u), math.sqrt(var_app + float(u @ c_cov @ u)))
 
     res = TurningResult(turn_side=side, approach_course=Estimate(float(psi0), psi0_se),
                         approach_speed=app_speed, steady=sw, drift=drift_obj,
                         sigma_position=(sigN, sigE), sigma_heading=sig_psi, notes=notes)
     dpsi = side * (psi - psi0)
     r_guess = abs(sw.rate.value)
+
+    def mark_fix_var(dt):
+        """Variance per axis of the tracking's slowly varying error between EXECUTE and a mark dt [s]
+        later: Σ 2 sd² (1 − e^{−dt/τ}) over its correlated parts when known (errors a mark's local fit
+        cannot average out), else 2 σ_fix² (the two fixes' errors taken independent)."""
+        if fix_errors:
+            return sum(2.0 * sd ** 2 * (1.0 - math.exp(-abs(dt) / tau)) for sd, tau in fix_errors if tau > 0.0)
+        return 2.0 * sigma_fix ** 2
 
     def position_at(tq, t_se):
         """Corrected position at tq (local cubic over ±mark_window_deg of heading), velocity, and the
@@ -731,8 +757,11 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         vN, sN_, varN, _, _ = _local_poly(tp[post], Nc[post], tq, hw, 3, sigN, min_pts=8)
         vE, sE_, varE, _, _ = _local_poly(tp[post], Ec[post], tq, hw, 3, sigE, min_pts=8)
         vel = np.array([sN_, sE_])
-        C = np.diag([varN + var_PeN, varE + var_PeE]) + t_se ** 2 * np.outer(vel, vel) \
-            + (tq - t_execute) ** 2 * Sd + 2.0 * sigma_fix ** 2 * np.eye(2)
+        # clocks: the mark's time (gyro) against the fixes' stamps (two loggers' errors), and the EXECUTE
+        # time (run log) against the fixes' (the EXECUTE point moves along the approach velocity)
+        C = np.diag([varN + var_PeN, varE + var_PeE]) + (t_se ** 2 + 2.0 * timing_sd ** 2) * np.outer(vel, vel) \
+            + timing_sd ** 2 * np.outer(v_app, v_app) \
+            + (tq - t_execute) ** 2 * Sd + mark_fix_var(tq - t_execute) * np.eye(2)
         return np.array([vN - PeN, vE - PeE]), vel, C
 
     def project(dP, C):
@@ -816,14 +845,14 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         if np.count_nonzero(mr) >= 3:
             mv = float(np.mean(ro[mr]))
             se = float(np.std(ro[mr], ddof=1) / math.sqrt(np.count_nonzero(mr))) * _ar1_inflation(ro[mr] - mv)
-            res.heel_steady = Estimate(mv, se, int(np.count_nonzero(mr)) - 1)
+            res.heel_steady = Estimate(mv, math.hypot(se, roll_bias), int(np.count_nonzero(mr)) - 1)
         ma_ = tr >= t_execute
         if np.count_nonzero(ma_) >= 5:
             tt, rr_ = tr[ma_], ro[ma_]
             k = int(np.argmax(np.abs(rr_)))
             hw = 3 * float(np.median(np.diff(tt)))
             val, _, var, _, _ = _local_poly(tt, rr_, tt[k], hw, 2, sig_r, min_pts=5)
-            res.heel_max = Estimate(val, math.sqrt(var))
+            res.heel_max = Estimate(val, math.sqrt(var + roll_bias ** 2))
     if rudder is not None:
         tr, rd = _clean(t if t_rudder is None else t_rudder, rudder)
         mr = (tr >= sw.t_start) & (tr <= sw.t_end)

@@ -282,9 +282,14 @@ def score_maneuvering(reduced: dict, res, name: str) -> dict:
             d["reduction_error"] = r["error"]
         elif r["type"] in ("turn", "pull_out"):
             d.update(_compare(r, tr, TURN_KEYS))
-            if r.get("drift") and tr.get("drift"):
-                d["drift_north"] = _cmp(r["drift"]["north"], tr["drift"][0])
-                d["drift_east"] = _cmp(r["drift"]["east"], tr["drift"][1])
+            dd = r.get("drift_of_day") or r.get("drift")
+            if dd and tr.get("drift"):
+                # the day's drift (the line through the circles at s = 0) is the current plus the circling
+                # ship's mean leeway of both sides: its reference by the same definition
+                # (drift_corrected_turns' leeway_drift_mps, the mean of the turns' second-loop drifts)
+                lee = tr.get("leeway_drift_mps", [0.0, 0.0])
+                d["drift_north"] = _cmp(dd["north"], tr["drift"][0] + lee[0])
+                d["drift_east"] = _cmp(dd["east"], tr["drift"][1] + lee[1])
             for k in ("advance", "tactical_diameter"):
                 if k in d and d[k].get("rel_error") is not None:
                     worst["turn_rel"] = max(worst["turn_rel"], abs(d[k]["rel_error"]))
