@@ -135,7 +135,7 @@ def test_drift_line_averages_the_side_dependent_push():
     assert line.tau[0] == pytest.approx(push, rel=0.2)
 
 
-def test_drift_line_with_a_side_term_for_turns():
+def test_drift_line_with_a_side_term_mean_of_sides():
     """The same circles with their sides given: the side term takes the ± push, the line at s = 0 is the
     current (the mean of both sides) with an uncertainty from its own noise only (τ beyond the side
     term ≈ 0, so far narrower than the plain line's τ-twice), and the side term's value is the push."""
@@ -149,7 +149,7 @@ def test_drift_line_with_a_side_term_for_turns():
               for k, s in enumerate(sides)]
     line = DriftLine(times, drifts, sides)
     for tt in (1000.0, 4000.0):
-        dn, de = line.for_turns(tt)
+        dn, de = line.mean_of_sides(tt)
         plain, _ = line(tt)
         assert dn.value == pytest.approx(0.2 + 1e-5 * tt, abs=0.01)
         assert de.value == pytest.approx(-0.1, abs=0.01)

@@ -282,7 +282,7 @@ def score_maneuvering(reduced: dict, res, name: str) -> dict:
             d["reduction_error"] = r["error"]
         elif r["type"] in ("turn", "pull_out"):
             d.update(_compare(r, tr, TURN_KEYS))
-            dd = r.get("drift_of_day") or r.get("drift")
+            dd = r.get("drift")
             if dd and tr.get("drift"):
                 # the day's drift (the line through the circles at s = 0) is the current plus the circling
                 # ship's mean leeway of both sides: its reference by the same definition
