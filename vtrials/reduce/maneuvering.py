@@ -59,14 +59,15 @@ class Channels:
         t, n = rec.channel(self.tracking, "north")
         _, e = rec.channel(self.tracking, "east")
         ok = np.isfinite(n) & np.isfinite(e)
+        tm = rec.meta(self.tracking)
         # time stamps back to the instant measured: less each instrument's stated latency
-        lag = float(rec.meta(self.tracking).get("latency_s", 0.0))
+        lag = float(tm.get("latency_s", 0.0))
         self.t, self.north, self.east = t[ok] - lag, n[ok], e[ok]
         g = k.get("heading", [None])[0]
         self.t_heading, self.heading = rec.channel(g, "heading") if g else (None, None)
-        if g:
-            self.t_heading = self.t_heading - float(rec.meta(g).get("latency_s", 0.0))
         gm = rec.meta(g) if g else {}
+        if g:
+            self.t_heading = self.t_heading - float(gm.get("latency_s", 0.0))
         self.gyro_drift = (float(gm.get("drift_std_rad", 0.0)), float(gm.get("drift_tau_s", 1.0)))
         self.gyro_bias = float(gm.get("bias_std", 0.0))
         # a water-track log (Doppler): surge and sway through the water, with its stated accuracy
@@ -97,10 +98,9 @@ class Channels:
         # the fixes are of the antenna: move them to the ship's reference point (midship, waterline)
         # with its surveyed position and the gyro / vertical-gyro attitude (IMO definitions refer to
         # the ship, and a 10-m lever arm is 10 % of a patrol vessel's transfer)
-        self.lever_arm = np.asarray(rec.meta(self.tracking).get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
-        self.sigma_fix = float(rec.meta(self.tracking).get("horizontal_accuracy_m", 0.0))
-        self.fix_errors = [tuple(x) for x in rec.meta(self.tracking).get("correlated_errors", [])]
-        tm = rec.meta(self.tracking)
+        self.lever_arm = np.asarray(tm.get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
+        self.sigma_fix = float(tm.get("horizontal_accuracy_m", 0.0))
+        self.fix_errors = [tuple(x) for x in tm.get("correlated_errors", [])]
         self._clock = (float(tm.get("clock_offset_sd_s", 0.0)), float(tm.get("clock_drift_ppm_sd", 0.0)),
                        float(tm.get("clock_t_ref_s", 0.0)))
         if self.heading is not None and np.any(self.lever_arm != 0.0):
