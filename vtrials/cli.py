@@ -63,6 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  inspect  list a trial record's channels, rates and units; plot chosen channels\n"
                "  campaign run many randomized replicates of an agenda; coverage and sharpness of every interval\n"
                "  render   render a run's truth as a video (MuJoCo, offscreen)\n"
+               "  identify identify the hull's maneuvering coefficients from maneuver records; predict held-back maneuvers\n"
                "  models   list the vessel models\n\nSee 'vtrials run --help' for the scenario format.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"vtrials {__version__}")
@@ -117,7 +118,53 @@ def build_parser() -> argparse.ArgumentParser:
     ren.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
     ren.add_argument("--speed", type=float, default=None,
                      help="simulated seconds per video second (default: the run in at most 60 s)")
+    idf = sub.add_parser("identify", help="identify maneuvering coefficients from maneuver records",
+                         description="Reconstruct each maneuver's motion from its records (EKF + RTS smoother), "
+                                     "regress the hull forces of the team's MMG model on it (inverse dynamics with the "
+                                     "known propeller, rudder and added mass), cross-validate model structures, "
+                                     "predict the held-back maneuvers, and score all of it against the truth when "
+                                     "the ship's model and the runs' results are at hand. Writes identification.json "
+                                     "and identification.png to DIR.")
+    idf.add_argument("records", nargs="+", metavar="RECORD", help="maneuver records (RUN_DIR/records/*.nc)")
+    idf.add_argument("--model", choices=("mmg", "abkowitz", "blanke"), default="mmg",
+                     help="hull model structure (default mmg, Yasukawa & Yoshimura 2015)")
+    idf.add_argument("--out", metavar="DIR", required=True, help="output directory")
+    idf.add_argument("--held-back", nargs="+", default=[], metavar="RECORD",
+                     help="records of maneuvers to predict (not fitted): turning circles and zig-zags")
+    idf.add_argument("--all-terms", action="store_true",
+                     help="predict with every term of the structure (default: the stepwise-selected terms)")
+    idf.add_argument("--no-score", action="store_true", help="reduce only; do not compare with the truth")
     return p
+
+
+def _identify(args) -> int:
+    import json
+    from vtrials.runner.staging import check_out, staged_output
+    from vtrials.sysid.identify import identify_records
+    check_out(args.out)
+    doc = identify_records(args.records, args.model, not args.all_terms, args.held_back)
+    if not args.no_score:
+        from vtrials.score.identification import score
+        doc["score"] = score(doc)
+    with staged_output(args.out) as out:
+        (out / "identification.json").write_text(json.dumps(doc, indent=1))
+        from vtrials.report.identification import identification_plot
+        identification_plot(doc, out / "identification.png")
+    print(f"identified the {len(doc['coefficients'])} hull terms of {doc['structure']} for {doc['ship']} from "
+          f"{len(doc['maneuvers'])} maneuver(s); {sum(len(v) for v in doc['prediction_model']['terms'].values())} "
+          "kept for predictions")
+    for k in ("Y_v", "Y_r", "N_v", "N_r"):
+        c = doc["coefficients"].get(k)
+        if c:
+            sc = doc.get("score", {}).get("coefficients", {}).get(k)
+            tail = f"   truth {sc['truth']:+.4f} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
+            print(f"  {k:<5} {c['value']:+.4f}  95 % [{c['lo95']:+.4f}, {c['hi95']:+.4f}]{tail}")
+    for p in doc["predictions"]:
+        print(f"  predicted {p['name']}: " + ", ".join(f"{k} {v:.3g}" for k, v in p["predicted"].items()))
+    if "score" in doc:
+        print(f"  verdict: {doc['score']['verdict']}")
+    print(f"wrote {args.out}/identification.json, identification.png")
+    return 0
 
 
 def _campaign(args) -> int:
@@ -267,6 +314,8 @@ def main(argv: list[str] | None = None) -> int:
             return _inspect(args)
         if args.command == "campaign":
             return _campaign(args)
+        if args.command == "identify":
+            return _identify(args)
         if args.command == "render":
             from vtrials.envs.video import render_run
             if args.fps < 1:

@@ -736,6 +736,23 @@ class IMU(Device):
     def drawn(self):
         return {"clock": self.clock.drawn(), "accelerometers": self.acc.drawn(), "gyros": self.gyr.drawn()}
 
+    def meta(self):
+        # the data sheet as the team has it (SI, 1σ): white noise per sample, turn-on bias and its
+        # in-run instability (Gauss–Markov σ, τ), bias random walks
+        m = super().meta()
+        s, ug, dph = self.spec, 9.80665e-6, DEG / 3600.0
+        agm = s.get("accel_gauss_markov_ug", {"sd": 0.0, "tau_s": 100.0})
+        ggm = s.get("gyro_gauss_markov_dph", {"sd": 0.0, "tau_s": 100.0})
+        m.update({"accel_noise_mps2": float(s.get("accel_noise_mps2", 0.0)),
+                  "gyro_noise_rps": float(s.get("gyro_noise_dps", 0.0)) * DEG,
+                  "accel_bias_std": float(s.get("accel_bias_ug", {}).get("sd", 0.0)) * ug,
+                  "gyro_bias_std": float(s.get("gyro_bias_dph", {}).get("sd", 0.0)) * dph,
+                  "accel_instability": [float(agm["sd"]) * ug, float(agm["tau_s"])],
+                  "gyro_instability": [float(ggm["sd"]) * dph, float(ggm["tau_s"])],
+                  "accel_random_walk": float(s.get("accel_random_walk_ug_rth", 0.0)) * ug / 60.0,
+                  "gyro_random_walk": float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0})
+        return m
+
 
 class Anemometer(Device):
     """Anemometer on a mast: apparent wind at the site (true wind at its height minus the site's own

@@ -47,6 +47,7 @@ class ManeuverRun:
     instruments: object = None  # the InstrumentSet that recorded this run
     events: list = dataclasses.field(default_factory=list)  # (time, run, code)
     orders: list = dataclasses.field(default_factory=list)  # (time, engine order)
+    ordered: dict = dataclasses.field(default_factory=dict)  # the maneuver as ordered (the director's sheet)
 
 
 @dataclasses.dataclass
@@ -188,8 +189,9 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
         events = [(max(0.0, t_exec[i] - 60.0), i + 1, 1), (t_exec[i], i + 1, 2), (t_finex[i], i + 1, 3)]
         order0 = m.approach_order or (scn.initial.engine_order if m.approach_speed_kn is None else None)
         orders = ([(0.0, order0)] if order0 else []) + ([(t_exec[i], m.order)] if getattr(m, "order", None) else [])
+        ordered = {"kind": m.kind, **{k: v for k, v in dataclasses.asdict(m).items() if v is not None}}
         runs.append(ManeuverRun(m.name, m.kind, t_exec[i], t_finex[i], completed[i], metrics, cols, iset, events,
-                                orders))
+                                orders, ordered))
     s0 = starts[0]
     U0 = abs(s0.u)
     initial = {"speed_mps": U0, "froude_number": speed_to_froude(U0, vessel.length),
@@ -237,7 +239,7 @@ def _write_outputs(result: RunResult, out: Path, plot: bool) -> dict:
             write_record(out / "records" / f"{m.name}.nc", m.instruments, m.finex_time_s, m.events, m.orders,
                          f"vtrials trial record: {m.name} ({m.kind}) — {result.scenario.head.title}",
                          {"trial": m.name, "kind": m.kind, "ship": result.scenario.vessel.name,
-                          "scenario_file": result.scenario.path.name})
+                          "scenario_file": result.scenario.path.name, "maneuver": m.ordered})
     if plot:
         from vtrials.report.plots import trajectory_plot
         with atomic_path(out / "trajectory.png") as tmp:

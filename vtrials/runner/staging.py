@@ -71,7 +71,7 @@ def check_out(out: str | Path) -> Path:
     return p
 
 
-OUTPUT_NAMES = ("results.json", "truth.nc", "records", "report.md", "trajectory.png")
+OUTPUT_NAMES = ("results.json", "truth.nc", "records", "report.md", "trajectory.png", "identification.json")
 
 
 def _is_output(x: Path) -> bool:

@@ -91,6 +91,7 @@ class Ship:
     kappa: float
     f_alpha: float      # rudder lift gradient
     x_R: float = -0.5   # x'_R
+    rudder_rate: float = 0.0   # steering gear's rated speed, rad/s (0: unknown; predictions need it)
 
     def masses(self) -> tuple[float, float, float, float]:
         """(m + m_x, m + m_y, x_G m, I_zG + x_G² m + J_z) in kg and kg m² (Y&Y eq. 4)."""
@@ -101,14 +102,26 @@ class Ship:
 
 def kvlcc2_l7() -> Ship:
     """KVLCC2 at model scale L7 (1/45.714). Source: Y&Y (2015) Tables 1-3, as tabulated in
-    docs/ships.md §1 (project reference set; x'_P −0.48, k2 −0.1385)."""
+    docs/ships.md §1 (project reference set; x'_P −0.48, k2 −0.1385); rudder rate 15.8°/s at model
+    scale (SIMMAN 2008, ships.md §1)."""
     rho, L = 1000.0, 7.00
     m = rho * 3.27
     return Ship(L=L, d=0.46, m=m, x_G=0.25, I_zG=m * (0.25 * L)**2, rho=rho,
                 mx=0.022, my=0.223, Jz=0.011, D_P=0.216, t_P=0.220, w_P0=0.40, x_P=-0.48,
                 k0=0.2931, k1=-0.2753, k2=-0.1385, C1=2.0, C2_pos=1.6, C2_neg=1.1, H_R=0.345,
                 A_R=0.0539, t_R=0.387, a_H=0.312, x_H=-0.464, gammaR_neg=0.395, gammaR_pos=0.640,
-                l_R=-0.710, eps=1.09, kappa=0.50, f_alpha=2.747)
+                l_R=-0.710, eps=1.09, kappa=0.50, f_alpha=2.747, rudder_rate=math.radians(15.8))
+
+
+#: The team's models by the ship name records carry (``team_knowledge.ship``).
+SHIPS = MappingProxyType({"kvlcc2_l7": kvlcc2_l7})
+
+
+def team_ship(name: str) -> Ship:
+    """The team's MMG model of a ship by name; a clear error for a ship without one."""
+    if name not in SHIPS:
+        raise InputError(_WHERE, "ship", f"no team maneuvering model for {name!r}; allowed: {', '.join(SHIPS)}")
+    return SHIPS[name]()
 
 
 def kvlcc2_hull() -> dict[str, float]:

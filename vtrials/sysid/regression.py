@@ -76,17 +76,27 @@ def hull_force_samples(ship: mmg.Ship, seg: Segment):
     return dict(X=(X - Xpr) / q, Y=(Y - Ypr) / q, N=(N - Npr) / (q * ship.L))
 
 
-def design(ship: mmg.Ship, segments, eq: str, terms):
+def design(ship: mmg.Ship, segments, eq: str, terms, weighted: bool = False):
     """Stacked regressor matrix and non-dimensional hull-force vector of equation ``eq`` (X, Y or N),
-    and the segment boundaries (for the HAC covariance, which must not lag across maneuvers)."""
+    and the segment boundaries (for the HAC covariance, which must not lag across maneuvers).
+
+    ``weighted``: rows scaled by U²/U²_max, i.e. the fit weighs dimensional forces. The errors of
+    reconstructed accelerations are about constant in newtons, so in prime units they grow as 1/U²
+    where a turn has lost half its speed; weighting by U² is the matching weighted least squares."""
     if eq not in ("X", "Y", "N"):
         raise InputError(_WHERE, "eq", f"{eq!r}; allowed: X, Y, N")
-    A, y, bounds = [], [], [0]
+    A, y, w, bounds = [], [], [], [0]
     for seg in segments:
         A.append(mmg.regressors(terms, seg.u, seg.v, seg.r, ship.L))
         y.append(hull_force_samples(ship, seg)[eq])
+        w.append(seg.u**2 + seg.v**2)
         bounds.append(bounds[-1] + len(seg.u))
-    return np.vstack(A), np.concatenate(y), bounds
+    A, y = np.vstack(A), np.concatenate(y)
+    if weighted:
+        w = np.concatenate(w)
+        w = w / w.max()
+        A, y = A * w[:, None], y * w
+    return A, y, bounds
 
 
 def _hac(A, e, bounds, lags: int):
@@ -103,8 +113,27 @@ def _hac(A, e, bounds, lags: int):
     return S
 
 
-def ols(A, y, terms, bounds=None, lags: int = 20) -> Fit:
-    """OLS with Newey-West covariance (``lags`` samples) and a BIC on the effective sample size.
+def _lag1(e, bounds) -> float:
+    """Lag-1 autocorrelation of residuals pooled within segments (never across a boundary)."""
+    num = sum(float(np.dot(e[a + 1:b], e[a:b - 1])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a > 1)
+    return float(np.clip(num / float(e @ e), 0.0, 0.999)) if e @ e > 0 else 0.0
+
+
+def andrews_lags(e, bounds=None) -> int:
+    """Bartlett-kernel bandwidth by Andrews' (1991, Econometrica 59:817, eqs. 6.2 and 6.4) AR(1)
+    plug-in rule, 1.1447 (α̂(1) n)^(1/3) with α̂(1) = 4ρ²/((1 − ρ)²(1 + ρ)²), ρ the residuals' lag-1
+    autocorrelation: residuals of smoothed records decorrelate over seconds, so the bandwidth follows
+    the data rather than a fixed count of samples."""
+    e = np.asarray(e, float)
+    bounds = [0, e.size] if bounds is None else list(bounds)
+    rho = _lag1(e, bounds)
+    a1 = 4.0 * rho**2 / ((1.0 - rho)**2 * (1.0 + rho)**2)
+    return int(min(e.size - 1, np.ceil(1.1447 * (a1 * e.size)**(1.0 / 3.0))))
+
+
+def ols(A, y, terms, bounds=None, lags: int | str = 20) -> Fit:
+    """OLS with Newey-West covariance (``lags`` samples, or "auto": :func:`andrews_lags`) and a BIC
+    on the effective sample size.
 
     The effective sample size is n (1 − ρ₁)/(1 + ρ₁) with ρ₁ the lag-1 residual autocorrelation
     (Bartlett 1946's AR(1) approximation)."""
@@ -115,29 +144,45 @@ def ols(A, y, terms, bounds=None, lags: int = 20) -> Fit:
     bounds = [0, n] if bounds is None else list(bounds)
     coef, *_ = np.linalg.lstsq(A, y, rcond=None)
     e = y - A @ coef
+    if lags == "auto":
+        lags = andrews_lags(e, bounds)
+    elif not (isinstance(lags, int) and lags >= 0):
+        raise InputError(_WHERE, "lags", f"{lags!r}; allowed: a whole number of samples ≥ 0 or 'auto'")
     AtA_inv = np.linalg.pinv(A.T @ A)
     cov = AtA_inv @ _hac(A, e, bounds, lags) @ AtA_inv * n / (n - p)
-    rho = float(np.clip(np.sum(e[1:] * e[:-1]) / np.sum(e * e), 0.0, 0.999))
+    rho = _lag1(e, bounds)
     n_eff = n * (1 - rho) / (1 + rho)
     rss = float(e @ e)
     bic = n_eff * np.log(rss / n) + p * np.log(n_eff)
     return Fit(tuple(terms), coef, cov, float(np.sqrt(rss / n)), n, n_eff, float(bic))
 
 
-def forward_select(ship, segments, eq: str, candidates, required=(), lags: int = 20) -> Fit:
+def forward_select(ship, segments, eq: str, candidates, required=(), lags: int | str = 20,
+                   min_t: float | None = None, weighted: bool = False) -> Fit:
     """Forward stepwise selection: start from ``required`` terms, add the candidate that lowers the
-    BIC most, stop when none does."""
+    BIC most, stop when none does. With ``min_t``, a candidate is admitted only if every non-required
+    term of the enlarged fit is significant, |coefficient| ≥ min_t σ under the HAC covariance
+    (stepwise regression's entry test, Efroymson 1960, in Draper & Smith 1998, "Applied Regression
+    Analysis", ch. 15): BIC alone keeps terms that fit the records' systematic errors, and cubic terms
+    that trade off against each other (v'²r', v'r'², v'³, r'³ are nearly collinear when v' follows r')
+    then extrapolate wildly beyond the maneuvers fitted."""
     chosen = [t for t in candidates if t in required]
     rest = [t for t in candidates if t not in required]
-    A_all, y, bounds = design(ship, segments, eq, list(candidates))
+    A_all, y, bounds = design(ship, segments, eq, list(candidates), weighted)
     col = {t: i for i, t in enumerate(candidates)}
 
     def fit(ts):
         return ols(A_all[:, [col[t] for t in ts]], y, ts, bounds, lags)
 
+    def admissible(f):
+        return min_t is None or all(abs(c) >= min_t * sg for k, c, sg in zip(f.terms, f.coef, f.sigma())
+                                    if k not in required)
+
     best = fit(chosen) if chosen else None
     while rest:
-        trials = [(fit(chosen + [t]), t) for t in rest]
+        trials = [(f, t) for f, t in ((fit(chosen + [t]), t) for t in rest) if admissible(f)]
+        if not trials:
+            break
         cand, t = min(trials, key=lambda ft: ft[0].bic)
         if best is not None and cand.bic >= best.bic:
             break
@@ -146,7 +191,8 @@ def forward_select(ship, segments, eq: str, candidates, required=(), lags: int =
     return best
 
 
-def identify(ship, segments, structure: str = "mmg", select: bool = True, lags: int = 20) -> dict:
+def identify(ship, segments, structure: str = "mmg", select: bool = True, lags: int | str = 20,
+             min_t: float | None = None, weighted: bool = False) -> dict:
     """Fit the hull terms of ``structure`` (a key of :data:`mmg.STRUCTURES`) to all segments.
 
     With ``select`` the terms are chosen by forward BIC selection (constant X_0 and the linear
@@ -157,9 +203,9 @@ def identify(ship, segments, structure: str = "mmg", select: bool = True, lags: 
     for eq, terms in mmg.STRUCTURES[structure].items():
         req = tuple(t for t in terms if t in mmg.LINEAR or t == "X_0")
         if select:
-            out[eq] = forward_select(ship, segments, eq, terms, req, lags)
+            out[eq] = forward_select(ship, segments, eq, terms, req, lags, min_t, weighted)
         else:
-            A, y, bounds = design(ship, segments, eq, terms)
+            A, y, bounds = design(ship, segments, eq, terms, weighted)
             out[eq] = ols(A, y, terms, bounds, lags)
     return out
 
@@ -170,7 +216,7 @@ def coefficients(fits: dict) -> dict:
 
 
 def cross_validate(ship, segments, structures=("mmg", "blanke"), select: bool = True,
-                   lags: int = 20) -> dict:
+                   lags: int | str = 20, min_t: float | None = None, weighted: bool = False) -> dict:
     """Leave-one-maneuver-out cross-validation of the hull-force prediction.
 
     For each structure: fit on all segments but one, predict the held-out segment's non-dimensional
@@ -182,9 +228,9 @@ def cross_validate(ship, segments, structures=("mmg", "blanke"), select: bool = 
         err = {eq: [] for eq in "XYN"}
         for i in range(len(segments)):
             train = [g for j, g in enumerate(segments) if j != i]
-            fits = identify(ship, train, s, select, lags)
+            fits = identify(ship, train, s, select, lags, min_t, weighted)
             for eq, ft in fits.items():
-                A, y, _ = design(ship, [segments[i]], eq, ft.terms)
+                A, y, _ = design(ship, [segments[i]], eq, ft.terms, weighted)
                 err[eq].append(y - A @ ft.coef)
         out[s] = {eq: float(np.sqrt(np.mean(np.concatenate(e)**2))) for eq, e in err.items()}
     return out

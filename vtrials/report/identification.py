@@ -1,0 +1,66 @@
+"""The identification's report figure: coefficients with their 95 % intervals (against the truth when
+scored), held-back predictions against the truth, and the cross-validation of model structures."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from vtrials.records.netcdf import atomic_path  # noqa: E402
+
+
+def identification_plot(doc: dict, path) -> None:
+    sc = doc.get("score")
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.8))
+    terms = [k for k in ("Y_v", "Y_r", "N_v", "N_r") if k in doc["coefficients"]]
+    terms += [k for k in doc["coefficients"] if k not in terms]
+    y = np.arange(len(terms))
+    c = [doc["coefficients"][k] for k in terms]
+    if sc:
+        t = np.array([sc["coefficients"][k]["truth"] for k in terms])
+        v = np.array([x["value"] for x in c]) - t
+        lo, hi = np.array([x["lo95"] for x in c]) - t, np.array([x["hi95"] for x in c]) - t
+        ax[0].axvline(0.0, color="k", lw=0.8)
+        ax[0].set_xlabel("identified − true (non-dimensional), 95 % interval")
+    else:
+        v = np.array([x["value"] for x in c])
+        lo, hi = np.array([x["lo95"] for x in c]), np.array([x["hi95"] for x in c])
+        ax[0].set_xlabel("identified value (non-dimensional), 95 % interval")
+    ax[0].errorbar(v, y, xerr=[v - lo, hi - v], fmt="o", ms=4, capsize=3)
+    ax[0].set_xscale("symlog", linthresh=0.01)
+    ax[0].set_yticks(y, terms)
+    ax[0].invert_yaxis()
+    ax[0].set_title(f"{doc['ship']}: hull coefficients ({doc['structure']})")
+    if doc["predictions"]:
+        labels, pred, true = [], [], []
+        for i, p in enumerate(doc["predictions"]):
+            rows = sc["predictions"][i]["errors"] if sc else {}
+            for k, val in p["predicted"].items():
+                labels.append(f"{p['name']}\n{k}")
+                pred.append(val)
+                true.append(rows[k]["truth"] if k in rows else np.nan)
+        x = np.arange(len(labels))
+        ax[1].bar(x - 0.2, pred, 0.4, label="predicted (identified model)")
+        if sc:
+            ax[1].bar(x + 0.2, true, 0.4, label="truth")
+        ax[1].set_xticks(x, labels, rotation=75, fontsize=6)
+        ax[1].legend(fontsize=8)
+        ax[1].set_title("held-back maneuvers (m, deg)")
+    else:
+        ax[1].text(0.5, 0.5, "no held-back maneuvers", ha="center", transform=ax[1].transAxes)
+    cv = doc.get("cross_validation") or {}
+    if cv:
+        names = list(cv)
+        for j, eq in enumerate("XYN"):
+            ax[2].bar(np.arange(len(names)) + 0.25 * (j - 1), [cv[n][eq] for n in names], 0.25, label=eq)
+        ax[2].set_xticks(np.arange(len(names)), names)
+        ax[2].set_ylabel("RMS of held-out hull force (non-dimensional)")
+        ax[2].legend(fontsize=8)
+        ax[2].set_title("leave-one-maneuver-out cross-validation")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)

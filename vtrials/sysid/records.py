@@ -1,0 +1,216 @@
+"""A maneuver record turned into what the identification needs: smoothed planar states and
+accelerations at the ship's reference point, with the recorded rudder angle and shaft speed.
+
+Reads records only (instrument channels, their stated errors, the director's sheet), never truth.
+
+* Time stamps: each instrument's stated latency removed (data sheet, record meta ``latency_s``).
+* Attitude: roll and pitch integrated from the motion package's rates by the Euler-angle kinematics
+  (Titterton & Weston 2004, "Strapdown Inertial Navigation Technology", eq. 3.48), started from the
+  accelerometers' gravity direction over the first seconds of the steady approach.
+* Specific force moved from the motion package to the reference point (midship, waterline: the origin
+  of the surveyed positions) by a_ref = a − ω̇×l − ω×(ω×l), then levelled into the heading frame
+  (x along the heading, horizontal): gravity drops out, so the planar filter integrates accelerations.
+  The heading rate ψ̇ = (q sin φ + r cos φ)/cos θ is the filter's gyro input.
+* Aiding: tracking fixes of the antenna (its surveyed height's horizontal displacement with heel and
+  trim removed; the horizontal lever arm left to the filter), gyro heading; σ from the stated
+  accuracies (white part ⊕ correlated parts, since the filter treats them as white).
+* The filter's bias random walks cover what the levelling leaves: an unknown roll-gyro bias b tilts
+  the levelled frame by b·t, i.e. a specific-force error g b t, matched over the record by a random
+  walk of density g σ_b √T.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+
+from vtrials.errors import InputError
+from vtrials.records.netcdf import Record
+from vtrials.sysid import navfilter as NF
+from vtrials.sysid import regression as RG
+
+_WHERE = "vtrials.sysid.records"
+G = 9.80665
+_SETTLE_S = 3.0   # first seconds of the approach used to find the level (ship steady)
+#: White yaw-jerk density of the filter's process model, (rad/s³)² s. A tuning, measured on the shipped
+#: agenda against truth (tests/test_identify_records.py): 1e-4 follows the gyro noise into r and ṙ and
+#: biases N'_v, N'_r by +1.6 %, +2.3 % (noisy regressors attenuate their coefficients); 1e-5 halves that.
+JERK_PSD = 1e-5
+
+
+@dataclasses.dataclass(frozen=True)
+class ManeuverRecord:
+    """One maneuver's inputs for the navigation filter and the identification (SI)."""
+
+    path: str
+    name: str
+    kind: str
+    ordered: dict          # the director's sheet: the maneuver as ordered (degrees at this edge)
+    ship: str
+    t: np.ndarray          # IMU instants (latency removed)
+    f: np.ndarray          # (N, 2) levelled specific force at the reference point, heading frame
+    psi_rate: np.ndarray   # (N,) heading rate from the rate gyros
+    roll: np.ndarray       # (N,) integrated roll, rad
+    aiding: tuple          # navfilter.Aiding
+    noise: NF.ImuNoise
+    delta: np.ndarray      # (N,) rudder angle at the IMU instants, rad
+    n: np.ndarray          # (N,) shaft speed, 1/s
+    t_execute: float
+    t_finex: float
+
+    def approach(self) -> dict:
+        """Speed over ground and shaft speed on the approach (before EXECUTE), as a team reads them."""
+        pos = next(a for a in self.aiding if a.kind == "position")
+        m = (pos.t < self.t_execute) & (pos.t > pos.t[0] + _SETTLE_S)
+        if m.sum() < 3:
+            raise InputError(self.path, "approach", "fewer than 3 fixes before EXECUTE; allowed: an approach of "
+                             f"at least {_SETTLE_S + 1:g} s")
+        tt, p = pos.t[m], pos.z[m]
+        vel = np.polyfit(tt - tt[0], p, 1)[0]
+        k = self.t < self.t_execute
+        return {"speed_mps": float(np.hypot(*vel)), "shaft_rps": float(np.mean(self.n[k]))}
+
+
+def _kinds(rec: Record) -> dict:
+    out: dict = {}
+    for name in rec.instruments:
+        out.setdefault(rec.meta(name).get("kind"), []).append(name)
+    return out
+
+
+def _need(kinds, kind, path, what):
+    if not kinds.get(kind):
+        raise InputError(path, "instruments", f"no {kind} instrument ({what}); the identification needs a "
+                         "tracking system (gnss), a heading gyro, a motion package (imu), a rudder synchro and "
+                         f"a shaft counter; the record has {', '.join(sorted(k for k in kinds if k))}")
+    return kinds[kind][0]
+
+
+def _channel(rec, inst, name):
+    t, y = rec.channel(inst, name)
+    return t - float(rec.meta(inst).get("latency_s", 0.0)), y
+
+
+def _attitude(t, w, f):
+    """Roll and pitch by Euler-angle kinematics from body rates w (N, 3), started level-by-gravity."""
+    k0 = t < t[0] + _SETTLE_S
+    fm = f[k0].mean(axis=0)
+    phi, th = math.atan2(-fm[1], -fm[2]), math.atan2(fm[0], math.hypot(fm[1], fm[2]))
+    def rates(ph, tt, p, q, r):
+        return (p + (q * math.sin(ph) + r * math.cos(ph)) * math.tan(tt), q * math.cos(ph) - r * math.sin(ph))
+
+    out = np.empty((t.size, 2))
+    out[0] = phi, th
+    for k in range(t.size - 1):          # Heun's method, rates linear over the step
+        dt = t[k + 1] - t[k]
+        a = rates(phi, th, *w[k])
+        b = rates(phi + dt * a[0], th + dt * a[1], *w[k + 1])
+        phi, th = phi + 0.5 * dt * (a[0] + b[0]), th + 0.5 * dt * (a[1] + b[1])
+        out[k + 1] = phi, th
+    return out[:, 0], out[:, 1]
+
+
+def read_maneuver(path: str | Path) -> ManeuverRecord:
+    """Read one maneuver record (a single maneuver's NetCDF record) into a :class:`ManeuverRecord`."""
+    path = str(path)
+    try:
+        rec = Record(path)
+    except (OSError, ValueError) as exc:
+        raise InputError(path, "record", f"cannot be read as a trial record ({exc}); allowed: a maneuver record "
+                         "written by 'vtrials run' (RUN_DIR/records/NAME.nc)") from None
+    kinds = _kinds(rec)
+    trk = kinds.get("gnss", [None])[0] or _need(kinds, "range_radar", path, "positions")
+    gyro = _need(kinds, "heading", path, "heading")
+    imu = _need(kinds, "imu", path, "accelerations and rates")
+    rud = _need(kinds, "rudder", path, "rudder angle")
+    rpm = _need(kinds, "shaft_rpm", path, "shaft speed")
+    ev = rec.events
+    lab = list(ev["label"])
+    if "EXECUTE" not in lab:
+        raise InputError(path, "_events", "no EXECUTE mark; allowed: a maneuver record with its EXECUTE time")
+    t_exec = float(ev["time"][lab.index("EXECUTE")])
+    t_finex = float(ev["time"][lab.index("FINEX")]) if "FINEX" in lab else math.inf
+
+    t, ax = _channel(rec, imu, "ax")
+    f = np.column_stack([ax] + [rec.channel(imu, c)[1] for c in ("ay", "az")])
+    w = np.column_stack([rec.channel(imu, c)[1] for c in ("p", "q", "r")])
+    im = rec.meta(imu)
+    phi, th = _attitude(t, w, f)
+    # specific force at the reference point: minus the lever arm's tangential and centripetal terms
+    arm = np.asarray(im.get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
+    wd = np.gradient(w, t, axis=0)
+    f = f - np.cross(wd, arm) - np.cross(w, np.cross(w, arm))
+    cf, sf, ct, st = np.cos(phi), np.sin(phi), np.cos(th), np.sin(th)
+    f_h = np.column_stack([ct * f[:, 0] + st * (sf * f[:, 1] + cf * f[:, 2]), cf * f[:, 1] - sf * f[:, 2]])
+    psi_rate = (w[:, 1] * sf + w[:, 2] * cf) / ct
+
+    # aiding: fixes (vertical lever arm's displacement removed) and heading
+    tp, north = _channel(rec, trk, "north")
+    _, east = rec.channel(trk, "east")
+    ok = np.isfinite(north) & np.isfinite(east)
+    tp, north, east = tp[ok], north[ok], east[ok]
+    tm = rec.meta(trk)
+    la = np.asarray(tm.get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
+    th_h, heading = _channel(rec, gyro, "heading")
+    heading = np.unwrap(heading)
+    psi = np.interp(tp, th_h, heading)
+    ph, tt = np.interp(tp, t, phi), np.interp(tp, t, th)
+    cp_, sp_ = np.cos(psi), np.sin(psi)
+    north = north - la[2] * (cp_ * np.sin(tt) * np.cos(ph) + sp_ * np.sin(ph))
+    east = east - la[2] * (sp_ * np.sin(tt) * np.cos(ph) - cp_ * np.sin(ph))
+    sig_pos = math.sqrt(float(tm.get("horizontal_accuracy_m", 0.01))**2
+                        + sum(float(s)**2 for s, _ in tm.get("correlated_errors", [])))
+    gm = rec.meta(gyro)
+    # the gyro's zero against the track on the steady straight approach (calm basin, no current: no
+    # drift angle there — the team's assumption, checked in the tests), then its wander over the record
+    k = (tp > tp[0] + _SETTLE_S) & (tp < t_exec)
+    if k.sum() < 5:
+        raise InputError(path, "approach", f"{int(k.sum())} fixes on the approach; allowed: at least 5 "
+                         f"(an approach of at least {_SETTLE_S + 1:g} s)")
+    tc = tp[k] - tp[k].mean()
+    vn, ve = np.polyfit(tc, north[k], 1)[0], np.polyfit(tc, east[k], 1)[0]
+    offset = float(np.angle(np.mean(np.exp(1j * (psi[k] - math.atan2(ve, vn))))))
+    heading = heading - offset
+    sig_course = sig_pos / math.sqrt(float(tc @ tc)) / math.hypot(vn, ve)
+    tau = float(gm.get("drift_tau_s", 900.0))
+    sig_head = math.sqrt(sig_course**2 + float(gm.get("resolution_rad", 0.0))**2 / 12.0
+                         + float(gm.get("drift_std_rad", 0.0))**2 * min(1.0, 2.0 * (tp[-1] - tp[0]) / tau))
+    aiding = (NF.Aiding("position", tp, np.column_stack([north, east]), sig_pos, (float(la[0]), float(la[1]))),
+              NF.Aiding("heading", th_h, heading, sig_head))
+
+    # the motion package's data sheet → the filter's noise model
+    T = float(t[-1] - t[0])
+    gb = math.hypot(float(im.get("gyro_bias_std", 1e-5)), float(im.get("gyro_instability", [0.0, 1.0])[0]))
+    ab_gm, ab_tau = (float(x) for x in im.get("accel_instability", [0.0, 100.0]))
+    ab = math.hypot(float(im.get("accel_bias_std", 1e-3)), ab_gm)
+    noise = NF.ImuNoise(
+        accel_sigma=float(im.get("accel_noise_mps2", 0.005)), gyro_sigma=float(im.get("gyro_noise_rps", 3e-4)),
+        accel_bias_rw=math.sqrt(2 * ab_gm**2 / ab_tau + float(im.get("accel_random_walk", 0.0))**2
+                                + (G * gb)**2 * T),
+        gyro_bias_rw=math.sqrt(2 * float(im.get("gyro_instability", [0.0, 1.0])[0])**2
+                               / float(im.get("gyro_instability", [0.0, 1.0])[1])
+                               + float(im.get("gyro_random_walk", 0.0))**2) or 1e-7,
+        jerk_psd=JERK_PSD, accel_bias0=2.0 * ab, gyro_bias0=2.0 * gb)
+
+    tr, dr = _channel(rec, rud, "angle")
+    tn, nr = _channel(rec, rpm, "rps")
+    return ManeuverRecord(path=path, name=str(rec.attr("trial", Path(path).stem)), kind=str(rec.attr("kind", "")),
+                          ordered=rec.attr("maneuver", {}) or {}, ship=str(rec.attr("ship", "")), t=t, f=f_h,
+                          psi_rate=psi_rate, roll=phi, aiding=aiding, noise=noise, delta=np.interp(t, tr, dr),
+                          n=np.interp(t, tn, nr), t_execute=t_exec, t_finex=t_finex)
+
+
+def reconstruct(mr: ManeuverRecord) -> NF.NavSolution:
+    """EKF + RTS smoother over the whole record (:func:`vtrials.sysid.navfilter.smooth`)."""
+    return NF.smooth(mr.t, mr.f, mr.psi_rate, list(mr.aiding), mr.noise)
+
+
+def segment(mr: ManeuverRecord, sol: NF.NavSolution, trim_s: float = 2.0) -> RG.Segment:
+    """The regression segment of one maneuver: the smoothed record less ``trim_s`` at each end (where
+    the smoother has data on one side only)."""
+    k = (sol.t >= sol.t[0] + trim_s) & (sol.t <= sol.t[-1] - trim_s)
+    s = RG.Segment.from_nav(sol, mr.delta, mr.n)
+    return RG.Segment(*(getattr(s, f.name)[k] for f in dataclasses.fields(RG.Segment)))
