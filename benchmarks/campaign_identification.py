@@ -112,7 +112,7 @@ def _replicate(args) -> dict:
     try:
         scn = _scenario(seed, scale, work)
         vtrials.run(str(scn), str(work / "run"), plot=False)
-        doc = identify_records(sorted((work / "run" / "records").glob("*.nc")), "mmg", True, held, compare=())
+        doc = identify_records(sorted((work / "run" / "records").glob("*.nc")), "mmg", True, held, compare=(), with_contributions=False)
         sc = score(doc)
     finally:
         shutil.rmtree(work, ignore_errors=True)

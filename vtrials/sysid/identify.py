@@ -10,6 +10,8 @@ validation among model structures → prediction of held-back maneuvers from the
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from vtrials.errors import InputError
@@ -30,8 +32,67 @@ def _team(mrs) -> str:
     return ships[0]
 
 
+def record_errors(mr: RE.ManeuverRecord) -> dict:
+    """Errors common to a whole record that neither the smoother nor the regression's residuals can
+    reveal, with their standard deviations: the gyro's zero left after the approach check (a heading
+    error turns the body velocities: sway is not observable without it) and the rudder synchro's
+    calibration. (The accelerometer and rate-gyro biases are not here: the tracking fixes bound their
+    effect on the reconstructed motion, and the smoother's covariance carries it.)"""
+    return {"heading": float(mr.heading_sd), "rudder": float(mr.rudder_sd)}
+
+
+def _perturbed(seg: RG.Segment, source: str, d: float) -> RG.Segment:
+    """A segment as it would be reconstructed with one record-wide error of size d."""
+    if source == "heading":     # body velocities and accelerations turn with the heading error
+        return dataclasses.replace(seg, u=seg.u + d * seg.v, v=seg.v - d * seg.u,
+                                   udot=seg.udot + d * seg.vdot, vdot=seg.vdot - d * seg.udot)
+    if source == "rudder":
+        return dataclasses.replace(seg, delta=seg.delta + d)
+    raise InputError(_WHERE, "source", f"{source!r}; allowed: heading, rudder")
+
+
+def systematic_covariance(ship, segs, errors, structure: str, fits) -> tuple[dict, dict]:
+    """Covariance of the coefficients from the record-wide errors (GUM, JCGM 100:2008 §5.1, sensitivity
+    by finite differences: each record's error moved by one σ, the whole structure refitted): {eq:
+    matrix over that fit's terms}, and each source's share of the variance of the linear derivatives."""
+    base = {eq: ft.coef for eq, ft in fits.items()}
+    cov = {eq: np.zeros((len(ft.terms),) * 2) for eq, ft in fits.items()}
+    share: dict = {}
+    for i, errs in enumerate(errors):
+        for source, sd in errs.items():
+            if not sd > 0:
+                continue
+            trial = segs[:i] + [_perturbed(segs[i], source, sd)] + segs[i + 1:]
+            for eq, ft in fits.items():
+                A, y, b = RG.design(ship, trial, eq, ft.terms, weighted=True)
+                d = np.linalg.lstsq(A, y, rcond=None)[0] - base[eq]
+                cov[eq] += np.outer(d, d)
+                for k, dk in zip(ft.terms, d):
+                    if k in mmg.LINEAR:
+                        share.setdefault(k, {}).setdefault(source, 0.0)
+                        share[k][source] += float(dk * dk)
+    return cov, share
+
+
+def contributions(ship, segs, names, structure: str = "mmg") -> dict:
+    """How much each maneuver adds: the linear derivatives' standard errors (whole structure, as
+    reported) with that maneuver left out, relative to all maneuvers — 1.0 adds nothing, 2.0 means the
+    derivative is known twice as well with it (the leave-one-out view of the information each input
+    brings; Jategaonkar 2006, "Flight Vehicle System Identification", ch. 2 on input design)."""
+    if len(segs) < 3:
+        return {}
+    base = RG.identify(ship, segs, structure, False, lags="auto", weighted=True)
+    sig0 = {k: s for ft in base.values() for k, s in zip(ft.terms, ft.sigma()) if k in mmg.LINEAR}
+    out = {}
+    for i, name in enumerate(names):
+        fits = RG.identify(ship, segs[:i] + segs[i + 1:], structure, False, lags="auto", weighted=True)
+        sig = {k: s for ft in fits.values() for k, s in zip(ft.terms, ft.sigma()) if k in mmg.LINEAR}
+        out[name] = {k: float(sig[k] / sig0[k]) for k in sig0}
+    return out
+
+
 def identify_records(paths, structure: str = "mmg", select: bool = True, held_back=(),
-                     compare=("mmg", "abkowitz", "blanke")) -> dict:
+                     compare=("mmg", "abkowitz", "blanke"), with_contributions: bool = True) -> dict:
     """Identify from the maneuver records ``paths``; predict the maneuvers of the ``held_back``
     records (their directors' sheets and approaches, never their motion). JSON-ready dict (SI; the
     coefficients non-dimensional, Y&Y 2015 prime system)."""
@@ -49,10 +110,15 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
     # model, whose terms are each significant, since the whole structure extrapolates wildly.
     fits = RG.identify(ship, segs, structure, False, lags="auto", weighted=True)
     model = RG.identify(ship, segs, structure, True, lags="auto", min_t=MIN_T, weighted=True) if select else fits
+    errors = [record_errors(m) for m in mrs]
+    sys_cov, sys_share = systematic_covariance(ship, segs, errors, structure, fits)
     coeffs = {}
-    for ft in fits.values():
-        for k, c, s in zip(ft.terms, ft.coef, ft.sigma()):
-            coeffs[k] = {"value": float(c), "std": float(s), "lo95": float(c - Z95 * s), "hi95": float(c + Z95 * s)}
+    for eq, ft in fits.items():
+        var_sys = np.diag(sys_cov[eq])
+        for k, c, s, vs in zip(ft.terms, ft.coef, ft.sigma(), var_sys):
+            sd = float(np.sqrt(s * s + vs))
+            coeffs[k] = {"value": float(c), "std": sd, "lo95": float(c - Z95 * sd), "hi95": float(c + Z95 * sd),
+                         "std_random": float(s), "std_systematic": float(np.sqrt(vs))}
     structures = tuple(dict.fromkeys((structure, *compare)))
     cv = (RG.cross_validate(ship, segs, structures, select, lags="auto", min_t=MIN_T, weighted=True)
           if len(segs) > 1 and compare else {})
@@ -81,7 +147,10 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
             "fit": {eq: {"rms": ft.rms, "n": ft.n, "n_eff": ft.n_eff, "bic": ft.bic} for eq, ft in model.items()},
             "cross_validation": cv, "best_structure_by_cv": best, "maneuvers": maneuvers,
             "predictions": predictions,
+            "contributions": contributions(ship, segs, [m.name for m in mrs], structure) if with_contributions else {},
             "known_parts": "mass, added mass, propeller and rudder of the team's MMG model (model tests, Y&Y 2015); "
                            "hull coefficients identified",
-            "interval": "95 %: ±1.96 σ, Newey–West (HAC) covariance of the equation-error regression, Bartlett "
-                        "bandwidth by Andrews' (1991) AR(1) plug-in rule"}
+            "record_errors": {m.name: e for m, e in zip(mrs, errors)}, "systematic_share": sys_share,
+            "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression (Bartlett "
+                        "bandwidth by Andrews' 1991 AR(1) rule) + the record-wide errors' variance (gyro zero, rudder "
+                        "synchro calibration; GUM sensitivities)"}

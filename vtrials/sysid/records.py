@@ -60,6 +60,8 @@ class ManeuverRecord:
     n: np.ndarray          # (N,) shaft speed, 1/s
     t_execute: float
     t_finex: float
+    rudder_sd: float = 0.0  # the synchro's stated calibration uncertainty (a zero error common to the record), rad
+    heading_sd: float = 0.0  # the gyro zero's error left over the record after the approach check, rad
 
     def approach(self) -> dict:
         """Speed over ground and shaft speed on the approach (before EXECUTE), as a team reads them."""
@@ -176,8 +178,11 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     heading = heading - offset
     sig_course = sig_pos / math.sqrt(float(tc @ tc)) / math.hypot(vn, ve)
     tau = float(gm.get("drift_tau_s", 900.0))
-    sig_head = math.sqrt(sig_course**2 + float(gm.get("resolution_rad", 0.0))**2 / 12.0
-                         + float(gm.get("drift_std_rad", 0.0))**2 * min(1.0, 2.0 * (tp[-1] - tp[0]) / tau))
+    # the gyro's wander since the check: a Gauss–Markov drift grows by σ √(2 T/τ) over T ≪ τ, a ramp
+    # whose mean square over the record is a third of its end value's
+    wander2 = float(gm.get("drift_std_rad", 0.0))**2 * min(1.0, 2.0 * (tp[-1] - tp[0]) / tau)
+    sig_head = math.sqrt(sig_course**2 + float(gm.get("resolution_rad", 0.0))**2 / 12.0 + wander2)
+    heading_sd = math.sqrt(sig_course**2 + wander2 / 3.0)
     aiding = (NF.Aiding("position", tp, np.column_stack([north, east]), sig_pos, (float(la[0]), float(la[1]))),
               NF.Aiding("heading", th_h, heading, sig_head))
 
@@ -200,7 +205,8 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     return ManeuverRecord(path=path, name=str(rec.attr("trial", Path(path).stem)), kind=str(rec.attr("kind", "")),
                           ordered=rec.attr("maneuver", {}) or {}, ship=str(rec.attr("ship", "")), t=t, f=f_h,
                           psi_rate=psi_rate, roll=phi, aiding=aiding, noise=noise, delta=np.interp(t, tr, dr),
-                          n=np.interp(t, tn, nr), t_execute=t_exec, t_finex=t_finex)
+                          n=np.interp(t, tn, nr), t_execute=t_exec, t_finex=t_finex, heading_sd=heading_sd,
+                          rudder_sd=float(rec.meta(rud).get("calibration_uncertainty_rad", rec.meta(rud).get("bias_std", 0.0))))
 
 
 def reconstruct(mr: ManeuverRecord) -> NF.NavSolution:

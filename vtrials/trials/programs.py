@@ -321,8 +321,92 @@ class SpeedChange(Maneuver):
         return TM.speed_change(tr["t"], tr["x_w"], tr["y_w"], tr["heading"], tr["u_r"], tr["v_r"])
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class PullOut(Maneuver):
+    """Pull-out (ITTC 7.5-04-02-01 §2.3): rudder ``rudder_deg`` until the heading has changed by
+    ``heading_change_deg``, then amidships for ``hold_s``; the rate of turn then decays to zero (a
+    course-stable ship) or to a residual rate (an unstable one)."""
+
+    rudder_deg: float = num("rudder angle of the turn, + starboard / − port", "deg", -90.0, 90.0)
+    heading_change_deg: float = num("heading change at which the rudder is put amidships", "deg", 10.0, 3600.0,
+                                    default=90.0)
+    hold_s: float = num("time with the rudder amidships before FINEX", "s", 0.0, 1e5, lo_open=True)
+    kind = "pull_out"
+
+    def rudders(self):
+        return [("rudder_deg", self.rudder_deg)]
+
+    def execute(self, psi0, ap):
+        s = 1.0 if self.rudder_deg >= 0 else -1.0
+        return Execute([(H.TURN_UNTIL, self.rudder_deg * DEG, s * self.heading_change_deg * DEG, 0.0, 0.0),
+                        (H.HOLD, 0.0)])
+
+    def finished(self, p):
+        return p.helm_phase >= 1 and p.phase_elapsed >= self.hold_s
+
+    def truth(self, tr):
+        dpsi = np.abs(tr["heading"] - tr["heading"][0])
+        k = int(np.searchsorted(dpsi, self.heading_change_deg * DEG)) if np.all(np.diff(dpsi) >= 0) else \
+            int(np.argmax(dpsi >= self.heading_change_deg * DEG))
+        return {"rate_at_amidships_dps": float(np.degrees(tr["r"][min(k, len(dpsi) - 1)])),
+                "residual_rate_dps": float(np.degrees(tr["r"][-1])),
+                "heading_change_deg": float(np.degrees(tr["heading"][-1] - tr["heading"][0]))}
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class Prbs(Maneuver):
+    """Pseudo-random binary rudder: ±``rudder_deg`` by a maximum-length sequence of ``stages`` 3 or 4
+    (7 or 15 bits of ``bit_s`` each; Godfrey 1993, "Perturbation Signals for System Identification",
+    ch. 3), first bit to the side of ``rudder_deg``'s sign, then amidships until FINEX. Runs of equal bits
+    are one helm phase each (the helm holds at most eight)."""
+
+    rudder_deg: float = num("rudder amplitude; its sign sets the first bit's side", "deg", -90.0, 90.0)
+    bit_s: float = num("duration of one bit", "s", 0.1, 1e4, lo_open=False)
+    stages: int = integer("shift-register stages (sequence length 2^stages − 1)", 3, 4, default=4)
+    seed: int = integer("initial register state (1 .. 2^stages − 1)", 1, 15, default=1)
+    kind = "prbs"
+
+    def rudders(self):
+        return [("rudder_deg", self.rudder_deg)]
+
+    def bits(self) -> np.ndarray:
+        """±1 bits: a Fibonacci shift register with taps (3, 2) or (4, 3) (Godfrey 1993, Table 3.1)."""
+        taps = {3: (3, 2), 4: (4, 3)}[self.stages]
+        state = [(self.seed >> i) & 1 for i in range(self.stages)] if self.seed % (2**self.stages) else [1] * self.stages
+        out = []
+        for _ in range(2**self.stages - 1):
+            out.append(state[-1])
+            fb = 0
+            for tp in taps:
+                fb ^= state[tp - 1]
+            state = [fb] + state[:-1]
+        b = 2.0 * np.array(out) - 1.0
+        return b * b[0] * (1.0 if self.rudder_deg >= 0 else -1.0)
+
+    def execute(self, psi0, ap):
+        b = self.bits()
+        runs, k = [], 0
+        while k < b.size:
+            j = k
+            while j < b.size and b[j] == b[k]:
+                j += 1
+            runs.append((b[k], (j - k) * self.bit_s))
+            k = j
+        phases = [(H.HOLD, v * abs(self.rudder_deg) * DEG, d) for v, d in runs]
+        phases[-1] = (H.HOLD, phases[-1][1], 0.0)       # the last run holds on; FINEX ends it
+        return Execute(phases)
+
+    def finished(self, p):
+        return p.elapsed >= self.bit_s * (2**self.stages - 1)
+
+    def truth(self, tr):
+        return {"heading_change_deg": float(np.degrees(tr["heading"][-1] - tr["heading"][0])),
+                "max_rate_dps": float(np.degrees(np.max(np.abs(tr["r"])))),
+                "final_speed_mps": float(np.hypot(tr["u_r"][-1], tr["v_r"][-1]))}
+
+
 KINDS = {cls.kind: cls for cls in (TurningCircle, ZigZag, Williamson, CourseKeeping, RudderStep, CrashStop,
-                                   SpeedChange)}
+                                   SpeedChange, PullOut, Prbs)}
 
 
 class ProgramSupervisor:
