@@ -16,6 +16,8 @@ prediction errors; and the growth of the RMS errors from noise ×1 to ×2.
 
     python benchmarks/campaign_identification.py --replicates 100 --workers 2 \
         --out benchmarks/results/campaign_identification.json
+    python benchmarks/campaign_identification.py --smoother --replicates 100 \
+        --out benchmarks/results/campaign_identification_smoother.json     # states and covariance vs truth
 """
 
 from __future__ import annotations
@@ -125,6 +127,32 @@ def _replicate(args) -> dict:
     return row
 
 
+def _smoother(args) -> dict:
+    """One replicate's smoother check: every maneuver reconstructed from its records and compared with
+    the truth (u, v, r at midship): RMS error and the fraction of samples inside ±1.96 σ."""
+    i, seed, tmp = args
+    import h5py
+    import vtrials
+    from vtrials.sysid import records as RE
+    work = Path(tmp) / f"s_{i}"
+    work.mkdir(parents=True, exist_ok=True)
+    out = {"replicate": i, "seed": seed, "states": {}}
+    try:
+        vtrials.run(str(_scenario(seed, 1, work)), str(work / "run"), plot=False)
+        with h5py.File(work / "run" / "truth.nc") as truth:
+            for p in sorted((work / "run" / "records").glob("*.nc")):
+                mr = RE.read_maneuver(p)
+                sol = RE.reconstruct(mr)
+                g = truth[mr.name]
+                for k, col in (("u", "u_r"), ("v", "v_r"), ("r", "r")):
+                    e = sol.state(k) - np.interp(sol.t, g["time"][:], g[col][:])
+                    out["states"].setdefault(k, []).append(
+                        (float(np.sqrt(np.mean(e**2))), float(np.mean(np.abs(e) <= 1.96 * sol.sigma(k)))))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return out
+
+
 def summarise(rows: list[dict]) -> dict:
     from vtrials.score.coverage import verdict
     out = {}
@@ -159,8 +187,12 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=2016)
     ap.add_argument("--noise-scale", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--smoother", action="store_true",
+                    help="check the smoother's states and covariance against truth instead (no identification)")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "campaign_identification.json"))
     a = ap.parse_args(argv)
+    if a.smoother:
+        return _smoother_campaign(a)
     import vtrials
     t0 = time.perf_counter()
     seeds = [int(s.generate_state(1)[0] % 2**31) for s in np.random.SeedSequence(a.seed).spawn(a.replicates)]
@@ -182,6 +214,25 @@ def main(argv=None) -> int:
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps(doc, indent=1))
     print(json.dumps(doc["summary"], indent=1))
+    return 0
+
+
+def _smoother_campaign(a) -> int:
+    t0 = time.perf_counter()
+    seeds = [int(s.generate_state(1)[0] % 2**31) for s in np.random.SeedSequence(a.seed).spawn(a.replicates)]
+    with tempfile.TemporaryDirectory() as tmp, ProcessPoolExecutor(a.workers) as ex:
+        rows = list(ex.map(_smoother, [(i, s, tmp) for i, s in enumerate(seeds)]))
+    summary = {}
+    for k in ("u", "v", "r"):
+        rms = np.array([x[0] for r in rows for x in r["states"][k]])
+        cov = np.array([x[1] for r in rows for x in r["states"][k]])
+        summary[k] = {"records": int(rms.size), "median_rms": float(np.median(rms)), "max_rms": float(rms.max()),
+                      "mean_coverage": float(cov.mean()), "min_coverage": float(cov.min())}
+    doc = {"campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
+           "smoother": summary, "rows": rows}
+    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(a.out).write_text(json.dumps(doc, indent=1))
+    print(json.dumps(summary, indent=1))
     return 0
 
 

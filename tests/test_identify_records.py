@@ -132,7 +132,7 @@ def test_record_wide_errors_move_the_fit_as_stated():
     ang = np.arctan2(h.v, h.u) - np.arctan2(seg.v, seg.u)
     assert np.allclose(ang, -d, rtol=1e-5) and np.allclose(np.hypot(h.u, h.v), np.hypot(seg.u, seg.v), rtol=1e-6)
     assert np.allclose(_perturbed(seg, "rudder", d).delta, seg.delta + d)
-    with pytest.raises(InputError, match="allowed: heading, rudder"):
+    with pytest.raises(InputError, match="allowed: heading, rudder, rudder_timing"):
         _perturbed(seg, "log", d)
 
 
@@ -198,3 +198,21 @@ def test_input_design_comparison(scenarios_dir, tmp_path):
         print(f"{name:<24}", {k: round(v, 3) for k, v in c.items()})
         assert set(c) == set(mmg.LINEAR) and all(0.5 < v < 3.0 for v in c.values())
     assert score(doc)["max_linear_rel_error"] < 0.10
+
+
+def test_andrews_bandwidth_on_ar1_residuals():
+    """Andrews (1991) AR(1) plug-in: for residuals e_t = ρ e_{t−1} + w_t the Bartlett bandwidth is
+    1.1447 (4ρ² n / ((1 − ρ)²(1 + ρ)²))^(1/3); white residuals get none. Segments are not lagged across."""
+    from vtrials.sysid.regression import andrews_lags
+    rng = np.random.default_rng(5)
+    n, rho = 20000, 0.9
+    w = rng.standard_normal(n)
+    e = np.empty(n)
+    e[0] = w[0]
+    for k in range(1, n):
+        e[k] = rho * e[k - 1] + w[k]
+    expected = 1.1447 * (4 * rho**2 * n / ((1 - rho)**2 * (1 + rho)**2)) ** (1 / 3)
+    assert andrews_lags(e) == pytest.approx(expected, rel=0.1)
+    assert andrews_lags(rng.standard_normal(n)) <= 3
+    # two independent halves glued: the boundary's jump is not counted as correlation
+    assert andrews_lags(np.concatenate([e[:n // 2], -e[n // 2:]]), [0, n // 2, n]) == pytest.approx(expected, rel=0.1)

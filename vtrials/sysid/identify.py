@@ -36,9 +36,11 @@ def record_errors(mr: RE.ManeuverRecord) -> dict:
     """Errors common to a whole record that neither the smoother nor the regression's residuals can
     reveal, with their standard deviations: the gyro's zero left after the approach check (a heading
     error turns the body velocities: sway is not observable without it) and the rudder synchro's
-    calibration. (The accelerometer and rate-gyro biases are not here: the tracking fixes bound their
+    calibration and its logger's clock offset against the motion package's (a rudder shift recorded
+    early or late). (The accelerometer and rate-gyro biases are not here: the tracking fixes bound their
     effect on the reconstructed motion, and the smoother's covariance carries it.)"""
-    return {"heading": float(mr.heading_sd), "rudder": float(mr.rudder_sd)}
+    return {"heading": float(mr.heading_sd), "rudder": float(mr.rudder_sd),
+            "rudder_timing": float(mr.rudder_timing_sd)}
 
 
 def _perturbed(seg: RG.Segment, source: str, d: float) -> RG.Segment:
@@ -48,7 +50,9 @@ def _perturbed(seg: RG.Segment, source: str, d: float) -> RG.Segment:
                                    udot=seg.udot + d * seg.vdot, vdot=seg.vdot - d * seg.udot)
     if source == "rudder":
         return dataclasses.replace(seg, delta=seg.delta + d)
-    raise InputError(_WHERE, "source", f"{source!r}; allowed: heading, rudder")
+    if source == "rudder_timing":   # the rudder record d seconds late
+        return dataclasses.replace(seg, delta=np.interp(seg.t + d, seg.t, seg.delta))
+    raise InputError(_WHERE, "source", f"{source!r}; allowed: heading, rudder, rudder_timing")
 
 
 def systematic_covariance(ship, segs, errors, structure: str, fits) -> tuple[dict, dict]:
@@ -153,4 +157,4 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
             "record_errors": {m.name: e for m, e in zip(mrs, errors)}, "systematic_share": sys_share,
             "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression (Bartlett "
                         "bandwidth by Andrews' 1991 AR(1) rule) + the record-wide errors' variance (gyro zero, rudder "
-                        "synchro calibration; GUM sensitivities)"}
+                        "synchro calibration and clock; GUM sensitivities)"}

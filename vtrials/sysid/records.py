@@ -62,6 +62,7 @@ class ManeuverRecord:
     t_finex: float
     rudder_sd: float = 0.0  # the synchro's stated calibration uncertainty (a zero error common to the record), rad
     heading_sd: float = 0.0  # the gyro zero's error left over the record after the approach check, rad
+    rudder_timing_sd: float = 0.0  # the rudder record's clock against the motion package's (stated offsets), s
 
     def approach(self) -> dict:
         """Speed over ground and shaft speed on the approach (before EXECUTE), as a team reads them."""
@@ -206,6 +207,8 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
                           ordered=rec.attr("maneuver", {}) or {}, ship=str(rec.attr("ship", "")), t=t, f=f_h,
                           psi_rate=psi_rate, roll=phi, aiding=aiding, noise=noise, delta=np.interp(t, tr, dr),
                           n=np.interp(t, tn, nr), t_execute=t_exec, t_finex=t_finex, heading_sd=heading_sd,
+                          rudder_timing_sd=math.hypot(float(rec.meta(rud).get("clock_offset_sd_s", 0.0)),
+                                                      float(im.get("clock_offset_sd_s", 0.0))),
                           rudder_sd=float(rec.meta(rud).get("calibration_uncertainty_rad", rec.meta(rud).get("bias_std", 0.0))))
 
 
