@@ -749,6 +749,7 @@ class IMU(Device):
                   "gyro_bias_std": float(s.get("gyro_bias_dph", {}).get("sd", 0.0)) * dph,
                   "accel_instability": [float(agm["sd"]) * ug, float(agm["tau_s"])],
                   "gyro_instability": [float(ggm["sd"]) * dph, float(ggm["tau_s"])],
+                  "gyro_scale_sd": float(s.get("gyro_scale", {}).get("sd", 0.0)),
                   "accel_random_walk": float(s.get("accel_random_walk_ug_rth", 0.0)) * ug / 60.0,
                   "gyro_random_walk": float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0})
         return m

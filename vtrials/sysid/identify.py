@@ -5,7 +5,8 @@ EKF + RTS smoother (:mod:`vtrials.sysid.navfilter`) → inverse-dynamics equatio
 the hull forces with the KNOWN mass, added mass, propeller and rudder of the team's MMG model
 (:mod:`vtrials.sysid.regression`; model-test values, Y&Y 2015) → leave-one-maneuver-out cross-
 validation among model structures → prediction of held-back maneuvers from their directors' sheets
-(:mod:`vtrials.sysid.predict`). Intervals: ±1.96 σ of the Newey–West covariance of the regression.
+(:mod:`vtrials.sysid.predict`). Intervals: ±1.96 σ, σ² the Newey–West variance of the regression
+plus the variance from errors common to a whole record (:func:`systematic_covariance`).
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ def _perturbed(seg: RG.Segment, source: str, d: float) -> RG.Segment:
     raise InputError(_WHERE, "source", f"{source!r}; allowed: heading, rudder, rudder_timing")
 
 
-def systematic_covariance(ship, segs, errors, structure: str, fits) -> tuple[dict, dict]:
+def systematic_covariance(ship, segs, errors, fits) -> tuple[dict, dict]:
     """Covariance of the coefficients from the record-wide errors (GUM, JCGM 100:2008 §5.1, sensitivity
     by finite differences: each record's error moved by one σ, the whole structure refitted): {eq:
     matrix over that fit's terms}, and each source's share of the variance of the linear derivatives."""
@@ -115,7 +116,7 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
     fits = RG.identify(ship, segs, structure, False, lags="auto", weighted=True)
     model = RG.identify(ship, segs, structure, True, lags="auto", min_t=MIN_T, weighted=True) if select else fits
     errors = [record_errors(m) for m in mrs]
-    sys_cov, sys_share = systematic_covariance(ship, segs, errors, structure, fits)
+    sys_cov, sys_share = systematic_covariance(ship, segs, errors, fits)
     coeffs = {}
     for eq, ft in fits.items():
         var_sys = np.diag(sys_cov[eq])

@@ -63,6 +63,7 @@ class ManeuverRecord:
     rudder_sd: float = 0.0  # the synchro's stated calibration uncertainty (a zero error common to the record), rad
     heading_sd: float = 0.0  # the gyro zero's error left over the record after the approach check, rad
     rudder_timing_sd: float = 0.0  # the rudder record's clock against the motion package's (stated offsets), s
+    gyro_scale_sd: float = 0.0  # the rate gyros' stated scale-factor error (relative)
 
     def approach(self) -> dict:
         """Speed over ground and shaft speed on the approach (before EXECUTE), as a team reads them."""
@@ -170,14 +171,14 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     # the gyro's zero against the track on the steady straight approach (calm basin, no current: no
     # drift angle there — the team's assumption, checked in the tests), then its wander over the record
     k = (tp > tp[0] + _SETTLE_S) & (tp < t_exec)
-    if k.sum() < 5:
-        raise InputError(path, "approach", f"{int(k.sum())} fixes on the approach; allowed: at least 5 "
-                         f"(an approach of at least {_SETTLE_S + 1:g} s)")
-    tc = tp[k] - tp[k].mean()
-    vn, ve = np.polyfit(tc, north[k], 1)[0], np.polyfit(tc, east[k], 1)[0]
-    offset = float(np.angle(np.mean(np.exp(1j * (psi[k] - math.atan2(ve, vn))))))
-    heading = heading - offset
-    sig_course = sig_pos / math.sqrt(float(tc @ tc)) / math.hypot(vn, ve)
+    if k.sum() >= 5:
+        tc = tp[k] - tp[k].mean()
+        vn, ve = np.polyfit(tc, north[k], 1)[0], np.polyfit(tc, east[k], 1)[0]
+        offset = float(np.angle(np.mean(np.exp(1j * (psi[k] - math.atan2(ve, vn))))))
+        heading = heading - offset
+        sig_course = sig_pos / math.sqrt(float(tc @ tc)) / math.hypot(vn, ve)
+    else:   # too few fixes on the approach (a tracking outage): the gyro's zero as its maker states it
+        sig_course = float(gm.get("bias_std", math.radians(0.25)))
     tau = float(gm.get("drift_tau_s", 900.0))
     # the gyro's wander since the check: a Gauss–Markov drift grows by σ √(2 T/τ) over T ≪ τ, a ramp
     # whose mean square over the record is a third of its end value's
@@ -201,6 +202,13 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
                                + float(im.get("gyro_random_walk", 0.0))**2) or 1e-7,
         jerk_psd=JERK_PSD, accel_bias0=2.0 * ab, gyro_bias0=2.0 * gb)
 
+    # the filter starts at the first fix: before it (a tracking outage at the start of the record) its
+    # initial position would be a later fix's, and it would hold the ship still to match
+    keep = t >= max(tp[0], th_h[0]) - 0.5 * float(np.median(np.diff(t)))
+    t, f_h, psi_rate, phi = t[keep], f_h[keep], psi_rate[keep], phi[keep]
+    if t.size < 3 or t[0] >= t_exec:
+        raise InputError(path, "tracking", f"the first fix is at {tp[0]:.1f} s, after EXECUTE ({t_exec:.1f} s); "
+                         "allowed: a record whose tracking starts on the approach")
     tr, dr = _channel(rec, rud, "angle")
     tn, nr = _channel(rec, rpm, "rps")
     return ManeuverRecord(path=path, name=str(rec.attr("trial", Path(path).stem)), kind=str(rec.attr("kind", "")),
@@ -209,12 +217,30 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
                           n=np.interp(t, tn, nr), t_execute=t_exec, t_finex=t_finex, heading_sd=heading_sd,
                           rudder_timing_sd=math.hypot(float(rec.meta(rud).get("clock_offset_sd_s", 0.0)),
                                                       float(im.get("clock_offset_sd_s", 0.0))),
-                          rudder_sd=float(rec.meta(rud).get("calibration_uncertainty_rad", rec.meta(rud).get("bias_std", 0.0))))
+                          rudder_sd=float(rec.meta(rud).get("calibration_uncertainty_rad", rec.meta(rud).get("bias_std", 0.0))),
+                          gyro_scale_sd=float(im.get("gyro_scale_sd", 0.0)))
 
 
 def reconstruct(mr: ManeuverRecord) -> NF.NavSolution:
-    """EKF + RTS smoother over the whole record (:func:`vtrials.sysid.navfilter.smooth`)."""
-    return NF.smooth(mr.t, mr.f, mr.psi_rate, list(mr.aiding), mr.noise)
+    """EKF + RTS smoother over the whole record (:func:`vtrials.sysid.navfilter.smooth`).
+
+    The filter takes the gyro's error as white; what is left of its zero after the approach check is
+    common to the whole record and turns the body velocities (δu = v δψ, δv = −u δψ), which no aiding
+    here can see; likewise the rate gyros' scale-factor error (δr = s r). Their variances are added to
+    the smoothed covariance along those directions, so the states' σ state what they cover."""
+    sol = NF.smooth(mr.t, mr.f, mr.psi_rate, list(mr.aiding), mr.noise)
+    P = sol.P.copy()
+    J = np.zeros((sol.t.size, len(NF.STATES)))
+    J[:, NF.STATES.index("psi")] = 1.0
+    J[:, NF.STATES.index("u")] = sol.state("v")
+    J[:, NF.STATES.index("v")] = -sol.state("u")
+    P += mr.heading_sd**2 * J[:, :, None] * J[:, None, :]
+    # the rate gyros' scale-factor error, common to the record: δr = s r (and δṙ = s ṙ)
+    J = np.zeros((sol.t.size, len(NF.STATES)))
+    J[:, NF.STATES.index("r")] = sol.state("r")
+    J[:, NF.STATES.index("rdot")] = sol.state("rdot")
+    P += mr.gyro_scale_sd**2 * J[:, :, None] * J[:, None, :]
+    return dataclasses.replace(sol, P=P)
 
 
 def segment(mr: ManeuverRecord, sol: NF.NavSolution, trim_s: float = 2.0) -> RG.Segment:
