@@ -156,6 +156,9 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
             "known_parts": "mass, added mass, propeller and rudder of the team's MMG model (model tests, Y&Y 2015); "
                            "hull coefficients identified",
             "record_errors": {m.name: e for m, e in zip(mrs, errors)}, "systematic_share": sys_share,
+            "intervals_checked": list(mmg.LINEAR),
+            "intervals_note": "coverage measured for the linear derivatives only (benchmarks/campaign_identification.py); "
+                              "the cubic terms trade off against one another and their intervals are not calibrated",
             "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression (Bartlett "
                         "bandwidth by Andrews' 1991 AR(1) rule) + the record-wide errors' variance (gyro zero, rudder "
                         "synchro calibration and clock; GUM sensitivities)"}
