@@ -41,7 +41,8 @@ from vtrials.reduce.estimate import Estimate
 TRACKING = ("gnss", "range_radar", "acoustic_range")
 
 
-def _kinds(rec: Record) -> dict:
+def instruments_by_kind(rec: Record) -> dict:
+    """{instrument kind: [instrument names]} of a record, in the record's order."""
     out: dict = {}
     for name in rec.instruments:
         out.setdefault(rec.meta(name).get("kind"), []).append(name)
@@ -52,7 +53,7 @@ class Channels:
     """The channels a maneuvering reduction reads, as arrays (SI)."""
 
     def __init__(self, rec: Record):
-        k = _kinds(rec)
+        k = instruments_by_kind(rec)
         self.tracking = next((n for kind in TRACKING for n in k.get(kind, [])), None)
         if self.tracking is None:
             raise ValueError(f"{rec.path}: no tracking system in the record")

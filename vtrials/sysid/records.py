@@ -29,6 +29,7 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.records.netcdf import Record
+from vtrials.reduce.maneuvering import instruments_by_kind
 from vtrials.sysid import navfilter as NF
 from vtrials.sysid import regression as RG
 
@@ -78,13 +79,6 @@ class ManeuverRecord:
         return {"speed_mps": float(np.hypot(*vel)), "shaft_rps": float(np.mean(self.n[k]))}
 
 
-def _kinds(rec: Record) -> dict:
-    out: dict = {}
-    for name in rec.instruments:
-        out.setdefault(rec.meta(name).get("kind"), []).append(name)
-    return out
-
-
 def _need(kinds, kind, path, what):
     if not kinds.get(kind):
         raise InputError(path, "instruments", f"no {kind} instrument ({what}); the identification needs a "
@@ -125,7 +119,7 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     except (OSError, ValueError) as exc:
         raise InputError(path, "record", f"cannot be read as a trial record ({exc}); allowed: a maneuver record "
                          "written by 'vtrials run' (RUN_DIR/records/NAME.nc)") from None
-    kinds = _kinds(rec)
+    kinds = instruments_by_kind(rec)
     trk = kinds.get("gnss", [None])[0] or _need(kinds, "range_radar", path, "positions")
     gyro = _need(kinds, "heading", path, "heading")
     imu = _need(kinds, "imu", path, "accelerations and rates")
