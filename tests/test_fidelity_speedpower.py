@@ -72,6 +72,24 @@ def test_acceleration_from_receiver_velocity():
     assert abs(sd - 0.05 / math.sqrt(np.sum((t - t.mean()) ** 2))) < 0.15 * sd
 
 
+def test_true_curve_ignores_a_second_point_at_the_same_speed():
+    """The scoring reference P_true(V) through calm-water points P = c V^3.4 (at the KVLCC2 trial's
+    speeds and midpoints), plus the end point that a setting above the engine's limit gives: the top
+    spot's steady state again, 2e-5 m/s and 1.5e-5 of power away (its twin converged to within the
+    steadiness tolerance). The curve must stay on c V^3.4 between the spots (reference: the power law
+    itself; the monotone cubic's own interpolation error is < 0.05 %)."""
+    from vtrials.score.trials import true_curve
+
+    c, q = 5.0e4, 3.4
+    v = np.array([4.766, 4.964, 5.516, 6.067, 6.619, 7.171, 7.557, 7.943, 8.163, 8.349349])
+    pts = [{"stw": x, "power": c * x ** q} for x in v]
+    pts.append({"stw": 8.349370, "power": c * 8.349349 ** q * (1 + 1.5e-5)})
+    P, (lo, hi) = true_curve(pts)
+    vv = np.linspace(lo, 8.349349, 200)
+    rel = P(vv) / (c * vv ** q) - 1.0
+    assert np.max(np.abs(rel)) < 5e-4, np.max(np.abs(rel))
+
+
 @pytest.fixture(scope="module")
 def kvlcc2_sp(tmp_path_factory, scenarios_dir):
     out = tmp_path_factory.mktemp("kvlcc2_sp")

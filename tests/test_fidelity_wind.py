@@ -78,3 +78,46 @@ def test_airwake_of_the_catalogue_anemometer_is_removed():
     s, g = SP.correct_airwake(sm, gm, m["airwake_speed"], m["airwake_direction_rad"])
     np.testing.assert_allclose(s, speed, rtol=1e-10)
     np.testing.assert_allclose(np.angle(np.exp(1j * (g - gamma))), 0.0, atol=1e-10)
+
+
+IDEAL_ANEMOMETER = {"distance_constant_m": 0.0, "start_threshold_mps": 0.0, "speed_bias_kn": 0.0,
+                    "speed_resolution_kn": 0.0, "direction_alignment_deg": 0.0, "direction_noise_deg": 0.0,
+                    "direction_resolution_deg": 0.0, "airwake_speed": [0.0], "airwake_direction_deg": [0.0],
+                    "rate_hz": 2.0}
+
+
+@pytest.mark.parametrize("exponent, z_ref", [(1.0 / 9.0, 10.0), (0.13, 20.0)])
+def test_anemometer_reads_the_simulated_wind_profile(exponent, z_ref):
+    """The mast anemometer reads the wind the simulated sea blows at its height: U₁₀ (h/10)^α with the
+    scenario's own profile (exponent α, reference height of the loads) — the profile the ship's wind
+    loads and the reduction's height correction use. (It used a 1/7 profile from 10 m of its own: on
+    the KVLCC2 mast, 38 m, the true wind read 4.3 % high and R_AA in head wind ~4 % high, which took
+    0.2-0.5 % off the trial's corrected power.) Reference: W.mean_wind_at_height."""
+    import dataclasses
+
+    from vtrials.physics.environment.current import Current
+    from vtrials.physics.simulator import ShipState, Simulator
+    from vtrials.scenario import environment_block, instrument_set, load_scenario
+    from vtrials.truth.columns import ship_columns
+
+    root = Path(__file__).resolve().parents[1]
+    scn = load_scenario(root / "scenarios" / "kvlcc2_speed_power.toml")
+    wind = dataclasses.replace(scn.wind, speed_kn=24.0, direction_deg=30.0, gust_spectrum="none",
+                               profile_exponent=exponent, reference_height_m=z_ref)
+    scn = dataclasses.replace(scn, wind=wind, current=Current(), instrument_items=[
+        {"name": "anemometer", "spec": "cup_vane_anemometer", "site": "anemometer", "clock": "none",
+         "set": IDEAL_ANEMOMETER}])
+    sim = Simulator(scn.vessel, 1, 0.05, environment_block(scn), planar=True)
+    sim.set_state(0, ShipState(shaft_rps=(0.0,) * sim.ns))
+    sim.step(400)  # 20 s at rest in slack water: the wind moves a VLCC by mm/s
+    cols = ship_columns(sim.truth(), sim.rec_names, 0)
+    iset = instrument_set(scn)
+    iset.reset()
+    iset.process(cols)
+    t, ch = iset.readings("anemometer")
+    h = -float(scn.vessel.sites["anemometer"][2])
+    assert h > 30.0  # a mast well above the 10 m reference: the profile matters
+    want = W.mean_wind_at_height(24.0 * 0.514444, h, exponent=exponent)
+    np.testing.assert_allclose(ch["speed"][t > 5.0], want, rtol=2e-3)
+    # the tolerance separates the old reading (a 1/7 profile from 10 m: +4.3 % at 38 m)
+    assert W.mean_wind_at_height(24.0 * 0.514444, h, exponent=1 / 7) / want - 1.0 > 0.01 or exponent != 1 / 9

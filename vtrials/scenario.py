@@ -270,11 +270,21 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda, waves=waves,
                    wave_loads=wave_loads)
     # the instrument suite (and the scenario's additions) are checked now, before anything runs
-    from vtrials.instruments.suite import InstrumentSet
-    InstrumentSet(vessel, head.seed, site, scn.instrument_items, f)
+    instrument_set(scn, scenario_file=f)
     if given and init.engine_order is None and scn.speed > 0.9 * _runaway_speed(vessel):
         raise InputError(f, "initial", f"approach speed {scn.speed:.2f} m/s is beyond this hull model's range")
     return scn
+
+
+def instrument_set(scn: Scenario, stream: tuple = (), scenario_file: str | None = None):
+    """The ship's instruments with the scenario's additions, reading the scenario's sea: anemometers
+    scale the truth's wind speed (at the wind's reference height) to their own height with the
+    simulated wind's profile (its exponent and reference height, as :func:`environment_block` packs
+    them), not with a profile of their own."""
+    from vtrials.instruments.suite import InstrumentSet
+    f = str(scn.path) if scenario_file is None else scenario_file  # the name messages give the file
+    return InstrumentSet(scn.vessel, scn.head.seed, scn.site, scn.instrument_items, f, stream=stream,
+                         wind_profile=(scn.wind.profile_exponent, scn.wind.reference_height_m))
 
 
 def _runaway_speed(vessel: Vessel) -> float:

@@ -19,6 +19,7 @@ from vtrials.units import DEG, KNOT, RPM
 from vtrials.instruments import parts as P
 from vtrials.instruments import sensor_errors as SE
 from vtrials.instruments.kinematics import SiteKinematics
+from vtrials.physics.environment.wind import TRIALS_PROFILE_EXPONENT, Z_REF_10
 
 UNIT_FACTORS = {"m": 1.0, "deg": DEG, "kn": KNOT, "m/s": 1.0, "rpm": RPM, "N m": 1.0, "N": 1.0, "1": 1.0,
                 "SI": 1.0, "m/s2": 1.0, "deg/s": DEG}
@@ -770,6 +771,10 @@ class Anemometer(Device):
     channels = {"speed": ("m s-1", "relative wind speed"),
                 "angle": ("rad", "relative wind angle it comes from, off the bow, + to starboard (0..2π)")}
 
+    #: the simulated wind's mean profile (power-law exponent, height [m] of the truth's wind speed);
+    #: :class:`vtrials.instruments.suite.InstrumentSet` sets the scenario's (``wind_profile``)
+    profile = (TRIALS_PROFILE_EXPONENT, Z_REF_10)
+
     def build(self):
         s = self.spec
         self.dc = float(s.get("distance_constant_m", 0.0))
@@ -808,7 +813,7 @@ class Anemometer(Device):
 
     def process(self, cols):
         kin = SiteKinematics(cols, self.site)
-        speed, gamma = kin.apparent_wind()
+        speed, gamma = kin.apparent_wind(*self.profile)
         speed, gamma = self.airwake(speed, gamma)
         t = cols["t"]
         if self.dc > 0.0 and t.size:

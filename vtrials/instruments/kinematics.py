@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vtrials.physics.environment.wind import TRIALS_PROFILE_EXPONENT, Z_REF_10
 from vtrials.units import G
 
 
@@ -79,19 +80,23 @@ class SiteKinematics:
         g_body = G * self.R[:, 2, :]  # Rᵀ (0, 0, g): third row of R
         return a - g_body
 
-    def apparent_wind(self, exponent: float = 1.0 / 7.0) -> tuple[np.ndarray, np.ndarray]:
+    def apparent_wind(self, exponent: float = TRIALS_PROFILE_EXPONENT,
+                      z_ref: float = Z_REF_10) -> tuple[np.ndarray, np.ndarray]:
         """Apparent wind at the site: (speed [m/s], angle it comes from off the bow [rad], + starboard).
 
-        True wind from the truth record (speed at the wind-load reference height, direction it blows
-        from) scaled to the site's height above the waterline by the power-law profile, minus the
-        site's own velocity over ground (ship motion, including the lever arm of the mast: the
-        motion-induced velocity); horizontal components in the ship's level frame.
+        True wind from the truth record (speed at the wind-load reference height ``z_ref`` [m],
+        direction it blows from) scaled to the site's height above the waterline by the power-law
+        profile U(h) = U(z_ref) (h/z_ref)^exponent, minus the site's own velocity over ground (ship
+        motion, including the lever arm of the mast: the motion-induced velocity); horizontal
+        components in the ship's level frame. ``exponent`` and ``z_ref`` must be the simulated
+        wind's own (:class:`vtrials.physics.environment.wind.Wind` ``profile_exponent``,
+        ``reference_height_m``; defaults: its defaults, 1/9 and 10 m), or the anemometer reads a
+        wind the ship does not feel.
         """
         c = self.c
         h = max(-self.position()[:, 2].mean(), 0.5)
         Uref = c["wind_speed"]
-        zref = 10.0
-        U = Uref * (h / zref) ** exponent if np.any(Uref) else Uref
+        U = Uref * (h / z_ref) ** exponent if np.any(Uref) else Uref
         d = c["wind_direction"]
         # wind velocity (towards) in world axes
         wn = -U * np.cos(d)

@@ -159,7 +159,11 @@ class InstrumentSet:
     """The instruments of one ship, streaming truth chunks into readings."""
 
     def __init__(self, vessel, seed: int, site_info: dict, scenario_items=None, scenario_file: str = "",
-                 stream: tuple = ()):
+                 stream: tuple = (), wind_profile: tuple[float, float] | None = None):
+        """``wind_profile``: (power-law exponent, reference height [m]) of the simulated wind's mean
+        profile — the scenario's :class:`vtrials.physics.environment.wind.Wind` ``profile_exponent``
+        and ``reference_height_m`` (:func:`vtrials.scenario.instrument_set`); anemometers scale the
+        truth's wind speed to their own height with it. None: the Wind defaults (1/9, 10 m)."""
         self.vessel = vessel
         cat = load_catalogue()
         suite_path = vessel.folder / "instruments.toml"
@@ -186,6 +190,8 @@ class InstrumentSet:
             e, sets, f, where = merged[name]
             self.devices[name] = self._build(e, sets, cat, f, where)
             self.clocks[name] = self._clock(e, cat, f, where)
+            if wind_profile is not None and self.devices[name].kind == "anemometer":
+                self.devices[name].profile = (float(wind_profile[0]), float(wind_profile[1]))
         self.seed = seed
         self.stream = tuple(stream)
         self._out: dict[str, list] = {}

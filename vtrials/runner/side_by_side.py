@@ -27,8 +27,7 @@ from vtrials.trials.driver import Driver
 from vtrials.trials.programs import ProgramSupervisor
 from vtrials.records.netcdf import atomic_path, write_groups
 from vtrials.runner.outputs import json_clean
-from vtrials.scenario import Scenario, environment_block, sea_vessel
-from vtrials.instruments.suite import InstrumentSet
+from vtrials.scenario import Scenario, environment_block, instrument_set, sea_vessel
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.records.trial import write_record
 from vtrials.truth.columns import describe, ship_columns
@@ -181,7 +180,7 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
         metrics = m.truth({k: v[ex] for k, v in cols.items()}) if np.count_nonzero(ex) > 2 else {}
         if not completed[i]:
             metrics["incomplete"] = f"FINEX condition not reached within {max_dur[i]:.0f} s after EXECUTE"
-        iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path), stream=(i,))
+        iset = instrument_set(scn, stream=(i,))
         iset.reset()
         n = len(cols["t"])
         for a in range(0, n, INSTRUMENT_CHUNK):

@@ -26,9 +26,8 @@ from vtrials import __version__
 from vtrials.trials.crew import Crew
 from vtrials.errors import InputError, SimulationError
 from vtrials.instruments.sea_observation import observe_sea
-from vtrials.instruments.suite import InstrumentSet
 from vtrials.records.netcdf import atomic_path, open_record, write_groups
-from vtrials.scenario import Scenario, environment_block, sea_vessel
+from vtrials.scenario import Scenario, environment_block, instrument_set, sea_vessel
 from vtrials.runner.outputs import json_clean
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.records.trial import write_record
@@ -102,7 +101,7 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
     calm = None if ship is vessel else Simulator(vessel, 1, scn.head.timestep_s, env, record_every=0)
     _initial_state(sim, scn, calm)
     timings["sea_setup_s"] = time.perf_counter() - t_wall
-    iset = InstrumentSet(vessel, scn.head.seed, scn.site, scn.instrument_items, str(scn.path))
+    iset = instrument_set(scn)
     sea = observe_sea(scn.waves, scn.head.seed)
     if sea:  # the wave buoy's (or hindcast's) sea state, for the analysis's wave correction
         iset.team["sea_observed"] = sea

@@ -26,6 +26,7 @@ from scipy.interpolate import PchipInterpolator
 
 from vtrials.reduce.estimate import Estimate
 from vtrials.reduce.trials import curve_power
+from vtrials.truth.calmwater import TWIN_TOL_MPS
 from vtrials.units import KNOT
 
 
@@ -48,10 +49,20 @@ def _truth_of(crew, trial: str) -> dict:
 
 
 def true_curve(points: list[dict]):
-    """P_true(V) [W] from calm-water points (monotone cubic in log–log)."""
+    """P_true(V) [W] from calm-water points (monotone cubic in log–log).
+
+    Points closer in speed than 10 × the twins' steadiness tolerance (:data:`TWIN_TOL_MPS`) are one
+    steady state as far as the curve can tell — their secant slope is convergence noise — and only the
+    first is kept. (Settings above the engine's limit all end at the limit's speed: the end point
+    "3 % above the top spot" then fell 2e-5 m/s from that spot, and the log–log secant of 0.2 between
+    them bent the monotone cubic up by 0.3–0.8 % of power over the last interval.)"""
     pts = sorted((p["stw"], p["power"]) for p in points if p["stw"] > 0 and p["power"] > 0)
-    v = np.array([p[0] for p in pts])
-    P = np.array([p[1] for p in pts])
+    kept = []
+    for q in pts:
+        if not kept or q[0] - kept[-1][0] >= 10.0 * TWIN_TOL_MPS:
+            kept.append(q)
+    v = np.array([p[0] for p in kept])
+    P = np.array([p[1] for p in kept])
     f = PchipInterpolator(np.log(v), np.log(P), extrapolate=False)
     return (lambda x: np.exp(f(np.log(np.asarray(x, float))))), (float(v.min()), float(v.max()))
 

@@ -41,8 +41,11 @@ def steady_points(vessel, rps: list[tuple], pitch: list[tuple], dt: float = 0.05
     return out
 
 
+TWIN_TOL_MPS = 2e-4  # [m/s] a twin is steady when its speed changes by less than this over a window
+
+
 def twin_points(vessel, settings: list[dict], dt: float, window_s: float = 120.0, max_s: float = 4000.0,
-                tol_mps: float = 2e-4) -> list[dict]:
+                tol_mps: float = TWIN_TOL_MPS) -> list[dict]:
     """Calm-water twins: ``settings`` is a list of {"rps": per shaft [rev/s], "pitch": per shaft or None,
     "modes": per shaft}. Each twin starts from the symmetric steady state at its mean setting, takes
     its own setting and is simulated (autopilot holding course) until its speed changes by less than
