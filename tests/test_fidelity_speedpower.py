@@ -116,4 +116,7 @@ def test_kvlcc2_speed_power_within_one_percent_in_head_and_tail_wind(kvlcc2_sp):
     print("power error at equal speed per spot [%]:", np.round(np.array(errs) * 100, 2),
           "net of the meters' calibration:", np.round(np.array(net) * 100, 2))
     assert len(errs) == 5
-    assert max(abs(e) for e in net) < 0.01
+    # seed 1501: total -0.87..-0.05 %, net of the meters -0.48..+0.44 % (after the anemometer's wind
+    # profile and the true curve's top point were fixed: -1.14..-0.37 % and -0.72..+0.12 % before)
+    assert max(abs(e) for e in errs) < 0.01
+    assert max(abs(e) for e in net) < 0.006
