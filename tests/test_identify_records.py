@@ -115,8 +115,9 @@ def test_approach_has_no_drift_angle(runs):
 def test_true_coefficients_from_model_file():
     t = true_coefficients("kvlcc2_l7")
     assert t["X_0"] == -0.022 and t["N_r"] == -0.049 and t["Y_vvv"] == -1.607
-    with pytest.raises(InputError, match="hull model"):
-        true_coefficients("patrol51")
+    p = true_coefficients("patrol51")   # BC93, dimensional; the resistance curve is a table, not a term
+    assert p["Y_uv"] == -11800.0 and p["N_ur"] == -4.71e6 and p["K_p"] == -500000.0 and "X_0" not in p
+    assert "astern_resistance_factor" not in p and "z_H" not in p
 
 
 def test_record_wide_errors_move_the_fit_as_stated():
@@ -138,7 +139,7 @@ def test_record_wide_errors_move_the_fit_as_stated():
 
 def test_bad_records(runs, tmp_path):
     with pytest.raises(InputError, match="no team maneuvering model"):
-        mmg.team_ship("patrol51")
+        mmg.team_ship("kvlcc2")
     with pytest.raises(InputError, match="records"):
         identify_records([])
     src = sorted((runs["identification"] / "records").glob("*.nc"))[0]

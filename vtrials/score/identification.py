@@ -3,7 +3,7 @@
 References, each by its own definition:
 
 * coefficients: the simulator's hull model of the ship (``models/<ship>/ship.toml``, section
-  ``hull_mmg``; X_0 = −R'_0). A term the model lacks is true at 0;
+  ``hull_mmg``, X_0 = −R'_0; or ``hull_blanke``, dimensional). A term the model lacks is true at 0;
 * held-back maneuvers: the truth metrics of the run that recorded them (``results.json`` of the run
   directory holding the record, :mod:`vtrials.truth.metrics`: advance, transfer and tactical diameter
   of the water track, zig-zag overshoots of the true heading).
@@ -25,15 +25,17 @@ _ZIGZAG = ("first_overshoot_deg", "second_overshoot_deg")
 
 
 def true_coefficients(ship: str) -> dict:
-    """{term: value} of the simulator's MMG hull model of ``ship`` (Y&Y 2015 prime system)."""
+    """{term: value} of the simulator's hull model of ``ship``: MMG (Y&Y 2015 prime system, X_0 = −R'_0)
+    or Blanke's 4-DOF model (dimensional, SI; its resistance curve is a table, not a term)."""
     from vtrials.physics.vessel import load_vessel
     v = load_vessel(ship)
-    if v.meta.hull_model != "mmg":
-        raise InputError(_WHERE, "ship", f"{ship!r} has a {v.meta.hull_model!r} hull model; allowed: an mmg hull "
-                         "(its coefficients are the identification's truth)")
+    if v.meta.hull_model not in ("mmg", "blanke"):
+        raise InputError(_WHERE, "ship", f"{ship!r} has a {v.meta.hull_model!r} hull model; allowed: an mmg or "
+                         "blanke hull (its coefficients are the identification's truth)")
     h = dataclasses.asdict(v.hull)
-    out = {k: float(val) for k, val in h.items() if k[:2] in ("X_", "Y_", "N_")}
-    out["X_0"] = -float(h["R0"])
+    out = {k: float(val) for k, val in h.items() if k[:2] in ("X_", "Y_", "K_", "N_")}
+    if v.meta.hull_model == "mmg":
+        out["X_0"] = -float(h["R0"])
     return out
 
 
@@ -58,7 +60,8 @@ def score(result: dict) -> dict:
         t = truth.get(k, 0.0)
         coeffs[k] = {"truth": t, "error": c["value"] - t, "rel_error": (c["value"] - t) / t if t else None,
                      "covered": bool(c["lo95"] <= t <= c["hi95"])}
-    linear = {k: coeffs[k]["rel_error"] for k in ("Y_v", "Y_r", "N_v", "N_r") if k in coeffs}
+    checked = result.get("intervals_checked") or ("Y_v", "Y_r", "N_v", "N_r")
+    linear = {k: coeffs[k]["rel_error"] for k in checked if k in coeffs}
     preds = []
     worst = {"turn_rel": 0.0, "overshoot_deg": 0.0}
     for p in result["predictions"]:

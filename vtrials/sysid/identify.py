@@ -40,8 +40,11 @@ def record_errors(mr: RE.ManeuverRecord) -> dict:
     calibration and its logger's clock offset against the motion package's (a rudder shift recorded
     early or late). (The accelerometer and rate-gyro biases are not here: the tracking fixes bound their
     effect on the reconstructed motion, and the smoother's covariance carries it.)"""
-    return {"heading": float(mr.heading_sd), "rudder": float(mr.rudder_sd),
-            "rudder_timing": float(mr.rudder_timing_sd)}
+    out = {"heading": float(mr.heading_sd), "rudder": float(mr.rudder_sd),
+           "rudder_timing": float(mr.rudder_timing_sd)}
+    if mr.pitch is not None:   # controllable pitch: the indicators' zero (the thrust the team computes)
+        out["pitch"] = float(mr.pitch_sd)
+    return out
 
 
 def _perturbed(seg: RG.Segment, source: str, d: float) -> RG.Segment:
@@ -53,7 +56,9 @@ def _perturbed(seg: RG.Segment, source: str, d: float) -> RG.Segment:
         return dataclasses.replace(seg, delta=seg.delta + d)
     if source == "rudder_timing":   # the rudder record d seconds late
         return dataclasses.replace(seg, delta=np.interp(seg.t + d, seg.t, seg.delta))
-    raise InputError(_WHERE, "source", f"{source!r}; allowed: heading, rudder, rudder_timing")
+    if source == "pitch" and seg.pitch is not None:
+        return dataclasses.replace(seg, pitch=seg.pitch + d)
+    raise InputError(_WHERE, "source", f"{source!r}; allowed: heading, rudder, rudder_timing, pitch (CP propellers)")
 
 
 def systematic_covariance(ship, segs, errors, fits) -> tuple[dict, dict]:
@@ -73,7 +78,7 @@ def systematic_covariance(ship, segs, errors, fits) -> tuple[dict, dict]:
                 d = np.linalg.lstsq(A, y, rcond=None)[0] - base[eq]
                 cov[eq] += np.outer(d, d)
                 for k, dk in zip(ft.terms, d):
-                    if k in mmg.LINEAR:
+                    if k in ship.linear:
                         share.setdefault(k, {}).setdefault(source, 0.0)
                         share[k][source] += float(dk * dk)
     return cov, share
@@ -87,26 +92,33 @@ def contributions(ship, segs, names, structure: str = "mmg") -> dict:
     if len(segs) < 3:
         return {}
     base = RG.identify(ship, segs, structure, False, lags="auto", weighted=True)
-    sig0 = {k: s for ft in base.values() for k, s in zip(ft.terms, ft.sigma()) if k in mmg.LINEAR}
+    sig0 = {k: s for ft in base.values() for k, s in zip(ft.terms, ft.sigma()) if k in ship.linear}
     out = {}
     for i, name in enumerate(names):
         fits = RG.identify(ship, segs[:i] + segs[i + 1:], structure, False, lags="auto", weighted=True)
-        sig = {k: s for ft in fits.values() for k, s in zip(ft.terms, ft.sigma()) if k in mmg.LINEAR}
+        sig = {k: s for ft in fits.values() for k, s in zip(ft.terms, ft.sigma()) if k in ship.linear}
         out[name] = {k: float(sig[k] / sig0[k]) for k in sig0}
     return out
 
 
-def identify_records(paths, structure: str = "mmg", select: bool = True, held_back=(),
-                     compare=("mmg", "abkowitz", "blanke"), with_contributions: bool = True) -> dict:
+def identify_records(paths, structure: str | None = None, select: bool = True, held_back=(),
+                     compare=None, with_contributions: bool = True) -> dict:
     """Identify from the maneuver records ``paths``; predict the maneuvers of the ``held_back``
     records (their directors' sheets and approaches, never their motion). JSON-ready dict (SI; the
-    coefficients non-dimensional, Y&Y 2015 prime system)."""
+    MMG model's coefficients non-dimensional, Y&Y 2015 prime system, the 4-DOF model's dimensional).
+
+    ``structure``: one of the team model's structures (default its first: "mmg" for KVLCC2, "blanke4"
+    for patrol51); ``compare``: the structures cross-validated (default all of the model's)."""
     paths = [str(p) for p in paths]
     if not paths:
         raise InputError(_WHERE, "records", "none given; allowed: one or more maneuver records (.nc)")
     mrs = [RE.read_maneuver(p) for p in paths]
     ship_name = _team(mrs)
     ship = mmg.team_ship(ship_name)
+    structure = structure or next(iter(ship.structures))
+    if structure not in ship.structures:
+        raise InputError(_WHERE, "model", f"{structure!r} for {ship_name}; allowed: {', '.join(ship.structures)}")
+    compare = tuple(ship.structures) if compare is None else compare
     sols = [RE.reconstruct(m) for m in mrs]
     segs = [RE.segment(m, s) for m, s in zip(mrs, sols)]
     # the coefficients and their intervals from the whole structure: a term dropped by selection would
@@ -127,7 +139,7 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
     structures = tuple(dict.fromkeys((structure, *compare)))
     cv = (RG.cross_validate(ship, segs, structures, select, lags="auto", min_t=MIN_T, weighted=True)
           if len(segs) > 1 and compare else {})
-    best = {eq: min(cv, key=lambda s: cv[s][eq]) for eq in "XYN"} if cv else {}
+    best = {eq: min(cv, key=lambda s: cv[s][eq]) for eq in ship.structures[structure]} if cv else {}
     fitted = RG.coefficients(model)
     maneuvers = []
     for m, sol, seg in zip(mrs, sols, segs):
@@ -146,17 +158,22 @@ def identify_records(paths, structure: str = "mmg", select: bool = True, held_ba
             raise InputError(str(p), "ship", f"{hb.ship!r}; allowed: {ship_name!r}, the identified ship")
         ap = hb.approach()
         predictions.append({"record": hb.path, "name": hb.name, "ordered": hb.ordered, "approach": ap,
-                            "predicted": PR.held_back(ship, fitted, hb.ordered, ap["speed_mps"], ap["shaft_rps"])})
+                            "predicted": PR.held_back(ship, fitted, hb.ordered, ap["speed_mps"], ap["shaft_rps"],
+                                                      ap.get("pitch_ratio", float("nan")))})
     return {"ship": ship_name, "structure": structure, "selected": bool(select), "coefficients": coeffs,
             "prediction_model": {"terms": {eq: list(ft.terms) for eq, ft in model.items()}, "coefficients": fitted},
             "fit": {eq: {"rms": ft.rms, "n": ft.n, "n_eff": ft.n_eff, "bic": ft.bic} for eq, ft in model.items()},
             "cross_validation": cv, "best_structure_by_cv": best, "maneuvers": maneuvers,
             "predictions": predictions,
             "contributions": contributions(ship, segs, [m.name for m in mrs], structure) if with_contributions else {},
-            "known_parts": "mass, added mass, propeller and rudder of the team's MMG model (model tests, Y&Y 2015); "
-                           "hull coefficients identified",
+            "known_parts": ("mass, added mass, propeller and rudder of the team's MMG model (model tests, Y&Y 2015); "
+                            "hull coefficients identified" if ship.prime else
+                            "mass, inertia, added mass (BC93), GM, tank resistance, the propellers' open-water chart at "
+                            "the indicated pitch and the rudders' lift, drag and interaction factors of the team's 4-DOF "
+                            "model; hull coefficients identified (dimensional, BC93's modulus structure)"),
+            "units": "non-dimensional (Y&Y 2015 prime system)" if ship.prime else "SI (dimensional, BC93)",
             "record_errors": {m.name: e for m, e in zip(mrs, errors)}, "systematic_share": sys_share,
-            "intervals_checked": list(mmg.LINEAR),
+            "intervals_checked": list(ship.linear),
             "intervals_note": "coverage measured for the linear derivatives only (benchmarks/campaign_identification.py); "
                               "the cubic terms trade off against one another and their intervals are not calibrated",
             "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression (Bartlett "

@@ -93,6 +93,40 @@ class Ship:
     x_R: float = -0.5   # x'_R
     rudder_rate: float = 0.0   # steering gear's rated speed, rad/s (0: unknown; predictions need it)
 
+    structures = STRUCTURES
+    linear = LINEAR
+    required = LINEAR + ("X_0",)
+    prime = True   # coefficients non-dimensional (Y&Y 2015 prime system)
+    state_names = ("x", "y", "psi", "u", "v", "r")
+
+    # -- the identification's interface (shared with vtrials.sysid.blanke.Ship4) ----------------------
+    def hull_samples(self, seg) -> dict:
+        """Non-dimensional hull forces X'_H, Y'_H, N'_H: inverse dynamics less the known propeller and
+        rudder (Y&Y eq. 4)."""
+        X, Y, N = inertial_forces(self, seg.u, seg.v, seg.r, seg.udot, seg.vdot, seg.rdot)
+        Xpr, Ypr, Npr = propeller_rudder_forces(self, seg.u, seg.v, seg.r, seg.delta, seg.n)
+        q = 0.5 * self.rho * self.L * self.d * (seg.u**2 + seg.v**2)
+        return {"X": (X - Xpr) / q, "Y": (Y - Ypr) / q, "N": (N - Npr) / (q * self.L)}
+
+    def regressors(self, terms, seg) -> np.ndarray:
+        return regressors(terms, seg.u, seg.v, seg.r, self.L)
+
+    def row_weights(self, seg) -> np.ndarray:
+        """U²: acceleration errors are about constant in newtons, in prime units they grow as 1/U²."""
+        return seg.u**2 + seg.v**2
+
+    def initial_state(self, speed: float) -> np.ndarray:
+        return np.array([0.0, 0.0, 0.0, speed, 0.0, 0.0])
+
+    def rates(self, coeffs: dict, y, delta: float, n: float, pitch: float = math.nan) -> np.ndarray:
+        """Time derivative of (x, y, ψ, u, v, r) under the given rudder and shaft rate (Y&Y eq. 4)."""
+        _, _, psi, u, v, r = y
+        XH, YH, NH = hull_forces(self, coeffs, u, v, r)
+        Xp, Yp, Np = propeller_rudder_forces(self, u, v, r, delta, n)
+        ud, vd, rd = accelerations(self, XH + Xp, YH + Yp, NH + Np, u, v, r)
+        c, s = math.cos(psi), math.sin(psi)
+        return np.array([u * c - v * s, u * s + v * c, r, float(ud), float(vd), float(rd)])
+
     def masses(self) -> tuple[float, float, float, float]:
         """(m + m_x, m + m_y, x_G m, I_zG + x_G² m + J_z) in kg and kg m² (Y&Y eq. 4)."""
         s = 0.5 * self.rho * self.L**2 * self.d
@@ -113,12 +147,18 @@ def kvlcc2_l7() -> Ship:
                 l_R=-0.710, eps=1.09, kappa=0.50, f_alpha=2.747, rudder_rate=math.radians(15.8))
 
 
+def _patrol51():
+    from vtrials.sysid.blanke import patrol51
+    return patrol51()
+
+
 #: The team's models by the ship name records carry (``team_knowledge.ship``).
-SHIPS = MappingProxyType({"kvlcc2_l7": kvlcc2_l7})
+SHIPS = MappingProxyType({"kvlcc2_l7": kvlcc2_l7, "patrol51": _patrol51})
 
 
-def team_ship(name: str) -> Ship:
-    """The team's MMG model of a ship by name; a clear error for a ship without one."""
+def team_ship(name: str):
+    """The team's model of a ship by name (MMG 3-DOF or the 4-DOF Blanke model); a clear error for a
+    ship without one."""
     if name not in SHIPS:
         raise InputError(_WHERE, "ship", f"no team maneuvering model for {name!r}; allowed: {', '.join(SHIPS)}")
     return SHIPS[name]()

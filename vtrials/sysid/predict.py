@@ -1,6 +1,7 @@
 """Standard maneuvers predicted with the team's identified model: turning circles and zig-zags.
 
-The 3-DOF model of :mod:`vtrials.sysid.mmg` (Y&Y 2015 eq. 4) with the identified hull terms, a
+The team's model (3-DOF MMG, :mod:`vtrials.sysid.mmg`, Y&Y 2015 eq. 4; or 4-DOF with roll,
+:mod:`vtrials.sysid.blanke`) with the identified hull terms, a
 steering gear that moves the rudder at its rated speed towards the ordered angle, and the shaft held
 at its approach speed (MMG practice, Y&Y 2015 §4). Classical fixed-step RK4 at ``dt``.
 
@@ -17,48 +18,44 @@ import math
 import numpy as np
 
 from vtrials.errors import InputError
-from vtrials.sysid import mmg
 
 _WHERE = "vtrials.sysid.predict"
 
 
-def _rhs(ship, coeffs, y, delta, n):
-    _, _, psi, u, v, r = y
-    XH, YH, NH = mmg.hull_forces(ship, coeffs, u, v, r)
-    Xp, Yp, Np = mmg.propeller_rudder_forces(ship, u, v, r, delta, n)
-    ud, vd, rd = mmg.accelerations(ship, XH + Xp, YH + Yp, NH + Np, u, v, r)
-    c, s = math.cos(psi), math.sin(psi)
-    return np.array([u * c - v * s, u * s + v * c, r, float(ud), float(vd), float(rd)])
-
-
-def simulate(ship: mmg.Ship, coeffs: dict, speed: float, n: float, helm, t_end: float, dt: float = 0.05,
-             rudder_rate: float | None = None) -> dict:
-    """Integrate from a steady straight approach at ``speed`` (m/s, heading 0) and shaft rate ``n``
-    (1/s). ``helm(t, state, delta) -> ordered rudder angle`` (rad), called every step; the rudder moves
-    towards it at ``rudder_rate`` (rad/s; default the ship's). Returns arrays t, x, y, psi, u, v, r, delta."""
+def simulate(ship, coeffs: dict, speed: float, n: float, helm, t_end: float, dt: float = 0.05,
+             rudder_rate: float | None = None, pitch: float = math.nan, stop=None) -> dict:
+    """Integrate from a steady straight approach at ``speed`` (m/s, heading 0), shaft rate ``n``
+    (1/s) and, for CP propellers, ``pitch`` (P/D). ``helm(t, state, delta) -> ordered rudder angle``
+    (rad), called every step; the rudder moves towards it at ``rudder_rate`` (rad/s; default the
+    ship's). The ship's ``rates`` give the dynamics (:class:`vtrials.sysid.mmg.Ship`: 3-DOF,
+    :class:`vtrials.sysid.blanke.Ship4`: 4-DOF). Returns arrays t, the ship's state names (x, y, psi,
+    u, v, r …) and delta, up to ``t_end`` or the first step at which ``stop(t, state)`` holds."""
     if not (speed > 0 and n > 0 and t_end > 0 and dt > 0):
         raise InputError(_WHERE, "simulate", f"speed {speed}, n {n}, t_end {t_end}, dt {dt}; allowed: all > 0")
     rate = ship.rudder_rate if rudder_rate is None else rudder_rate
     if not rate > 0:
         raise InputError(_WHERE, "rudder_rate", f"{rate}; allowed: > 0 rad/s (the steering gear's rated speed)")
     steps = int(math.ceil(t_end / dt))
-    y = np.array([0.0, 0.0, 0.0, speed, 0.0, 0.0])
+    y = ship.initial_state(speed)
     d = 0.0
-    out = np.empty((steps + 1, 8))
+    out = np.empty((steps + 1, y.size + 2))
     out[0] = 0.0, *y, d
     for k in range(steps):
         t = k * dt
         order = helm(t, y, d)
         d = d + float(np.clip(order - d, -rate * dt, rate * dt))
-        k1 = _rhs(ship, coeffs, y, d, n)
-        k2 = _rhs(ship, coeffs, y + 0.5 * dt * k1, d, n)
-        k3 = _rhs(ship, coeffs, y + 0.5 * dt * k2, d, n)
-        k4 = _rhs(ship, coeffs, y + dt * k3, d, n)
+        k1 = ship.rates(coeffs, y, d, n, pitch)
+        k2 = ship.rates(coeffs, y + 0.5 * dt * k1, d, n, pitch)
+        k3 = ship.rates(coeffs, y + 0.5 * dt * k2, d, n, pitch)
+        k4 = ship.rates(coeffs, y + dt * k3, d, n, pitch)
         y = y + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
         if not np.all(np.isfinite(y)):
             raise RuntimeError(f"{_WHERE}: the identified model diverged at t = {t + dt:.2f} s, state {y.tolist()}")
         out[k + 1] = t + dt, *y, d
-    return dict(zip(("t", "x", "y", "psi", "u", "v", "r", "delta"), out.T))
+        if stop is not None and stop(t + dt, y):
+            out = out[:k + 2]
+            break
+    return dict(zip(("t", *ship.state_names, "delta"), out.T))
 
 
 def _at(t, f, level):
@@ -71,11 +68,13 @@ def _at(t, f, level):
     return float(t[i - 1] + a * (t[i] - t[i - 1]))
 
 
-def turning_circle(ship, coeffs, speed, n, rudder_deg: float, t_end: float | None = None, dt: float = 0.05) -> dict:
+def turning_circle(ship, coeffs, speed, n, rudder_deg: float, t_end: float | None = None, dt: float = 0.05,
+                   pitch: float = math.nan) -> dict:
     """Advance, transfer and tactical diameter (m) of a turn with the rudder put over at t = 0."""
     t_end = t_end or 40.0 * ship.L / speed
     delta = math.radians(rudder_deg)
-    s = simulate(ship, coeffs, speed, n, lambda t, y, d: delta, t_end, dt)
+    s = simulate(ship, coeffs, speed, n, lambda t, y, d: delta, t_end, dt, pitch=pitch,
+                 stop=lambda t, y: abs(y[2]) > math.radians(181.0))
     out = {}
     for key, level, coord in (("advance_m", 90, "x"), ("transfer_m", 90, "y"), ("tactical_diameter_m", 180, "y")):
         tq = _at(s["t"], s["psi"], math.radians(level))
@@ -86,7 +85,7 @@ def turning_circle(ship, coeffs, speed, n, rudder_deg: float, t_end: float | Non
 
 
 def zigzag(ship, coeffs, speed, n, rudder_deg: float, check_deg: float, first_side: int,
-           t_end: float | None = None, dt: float = 0.05) -> dict:
+           t_end: float | None = None, dt: float = 0.05, pitch: float = math.nan) -> dict:
     """First and second overshoot angles (deg) of a δ/ψ zig-zag, first rudder to ``first_side`` (+1
     starboard, −1 port)."""
     t_end = t_end or 30.0 * ship.L / speed
@@ -100,7 +99,7 @@ def zigzag(ship, coeffs, speed, n, rudder_deg: float, check_deg: float, first_si
             shifts.append(t)
         return side[0] * a
 
-    s = simulate(ship, coeffs, speed, n, helm, t_end, dt)
+    s = simulate(ship, coeffs, speed, n, helm, t_end, dt, pitch=pitch, stop=lambda t, y: len(shifts) >= 3)
     if len(shifts) < 3:
         raise RuntimeError(f"{_WHERE}: the predicted zig-zag made {len(shifts)} rudder shifts in {t_end:.0f} s; "
                            "3 are needed for two overshoots")
@@ -111,13 +110,14 @@ def zigzag(ship, coeffs, speed, n, rudder_deg: float, check_deg: float, first_si
             "second_overshoot_deg": math.degrees(-float(psi[k2].min()) - c)}
 
 
-def held_back(ship, coeffs, ordered: dict, speed: float, n: float) -> dict:
+def held_back(ship, coeffs, ordered: dict, speed: float, n: float, pitch: float = math.nan) -> dict:
     """Predict a maneuver from the director's sheet (``ordered``: kind, rudder_deg, heading_deg,
     first_side) at the given approach."""
     kind = ordered.get("kind")
     if kind == "turning_circle":
-        return turning_circle(ship, coeffs, speed, n, float(ordered["rudder_deg"]))
+        return turning_circle(ship, coeffs, speed, n, float(ordered["rudder_deg"]), pitch=pitch)
     if kind == "zigzag":
         side = 1 if ordered.get("first_side", "starboard") == "starboard" else -1
-        return zigzag(ship, coeffs, speed, n, float(ordered["rudder_deg"]), float(ordered["heading_deg"]), side)
+        return zigzag(ship, coeffs, speed, n, float(ordered["rudder_deg"]), float(ordered["heading_deg"]), side,
+                      pitch=pitch)
     raise InputError(_WHERE, "maneuver.kind", f"{kind!r}; allowed: turning_circle, zigzag")

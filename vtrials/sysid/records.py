@@ -26,6 +26,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from scipy.signal import butter, filtfilt, savgol_filter
 
 from vtrials.errors import InputError
 from vtrials.records.netcdf import Record
@@ -40,6 +41,13 @@ _SETTLE_S = 3.0   # first seconds of the approach used to find the level (ship s
 #: agenda against truth (tests/test_identify_records.py): 1e-4 follows the gyro noise into r and ṙ and
 #: biases N'_v, N'_r by +1.6 %, +2.3 % (noisy regressors attenuate their coefficients); 1e-5 halves that.
 JERK_PSD = 1e-5
+#: Window of the roll acceleration's local-cubic derivative, s: a tenth of patrol51's 5.6 s roll period
+#: keeps the roll's own swing (the cubic's bias at that window is under 1 %).
+ROLL_WINDOW_S = 0.55
+#: Time constant of the complementary filter between the integrated rates and a vertical reference, s:
+#: the integral's drift over it (≈ 4e-4 rad) and the reference's noise averaged over it (0.03°/√(10 Hz × τ))
+#: are both below the reference's resolution.
+VERTICAL_TAU_S = 10.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -57,14 +65,18 @@ class ManeuverRecord:
     roll: np.ndarray       # (N,) integrated roll, rad
     aiding: tuple          # navfilter.Aiding
     noise: NF.ImuNoise
-    delta: np.ndarray      # (N,) rudder angle at the IMU instants, rad
-    n: np.ndarray          # (N,) shaft speed, 1/s
+    delta: np.ndarray      # (N,) rudder angle at the IMU instants, rad (mean over the rudders)
+    n: np.ndarray          # (N,) shaft speed, 1/s (mean over the shafts)
     t_execute: float
     t_finex: float
     rudder_sd: float = 0.0  # the synchro's stated calibration uncertainty (a zero error common to the record), rad
     heading_sd: float = 0.0  # the gyro zero's error left over the record after the approach check, rad
     rudder_timing_sd: float = 0.0  # the rudder record's clock against the motion package's (stated offsets), s
     gyro_scale_sd: float = 0.0  # the rate gyros' stated scale-factor error (relative)
+    p: np.ndarray | None = None      # (N,) roll rate from the motion package, rad/s
+    pdot: np.ndarray | None = None   # (N,) roll acceleration (its smoothed derivative), rad/s²
+    pitch: np.ndarray | None = None  # (N,) indicated pitch ratio of controllable-pitch propellers (mean)
+    pitch_sd: float = 0.0            # the pitch indicators' stated zero error (common to the record)
 
     def approach(self) -> dict:
         """Speed over ground and shaft speed on the approach (before EXECUTE), as a team reads them."""
@@ -76,7 +88,10 @@ class ManeuverRecord:
         tt, p = pos.t[m], pos.z[m]
         vel = np.polyfit(tt - tt[0], p, 1)[0]
         k = self.t < self.t_execute
-        return {"speed_mps": float(np.hypot(*vel)), "shaft_rps": float(np.mean(self.n[k]))}
+        out = {"speed_mps": float(np.hypot(*vel)), "shaft_rps": float(np.mean(self.n[k]))}
+        if self.pitch is not None:
+            out["pitch_ratio"] = float(np.mean(self.pitch[k]))
+        return out
 
 
 def _need(kinds, kind, path, what):
@@ -85,6 +100,12 @@ def _need(kinds, kind, path, what):
                          "tracking system (gnss), a heading gyro, a motion package (imu), a rudder synchro and "
                          f"a shaft counter; the record has {', '.join(sorted(k for k in kinds if k))}")
     return kinds[kind][0]
+
+
+def _position_sd(meta: dict) -> float:
+    """A tracking system's stated position error: the white part ⊕ the correlated parts, m."""
+    return math.sqrt(float(meta.get("horizontal_accuracy_m", 0.01))**2
+                     + sum(float(s)**2 for s, _ in meta.get("correlated_errors", [])))
 
 
 def _channel(rec, inst, name):
@@ -111,6 +132,30 @@ def _attitude(t, w, f):
     return out[:, 0], out[:, 1]
 
 
+def _vertical_reference(rec, inst, t, phi, th):
+    """Integrated roll and pitch with their slow drift taken from a vertical reference: a complementary
+    filter (Higgins 1975, IEEE Trans. Aerosp. Electron. Syst. AES-11:321) — the rates' integral above
+    1/(2π VERTICAL_TAU_S), the vertical reference below it, run forward and back (zero phase: the record
+    is whole). The reference's own zero is set against the gravity level on the approach's first
+    seconds. The integral drifts by the rate gyros' bias and misalignment (a 0.05° misalignment in a
+    0.04 rad/s turn is 3.5e-5 rad/s of false roll rate, 0.2° over a turn), which would level the
+    specific force wrongly (g × 0.003 rad = 0.03 m/s² of false sway acceleration)."""
+    tv, roll = _channel(rec, inst, "roll")
+    _, pitch = rec.channel(inst, "pitch")
+    ok = np.isfinite(roll) & np.isfinite(pitch)
+    if ok.sum() < 10:
+        return phi, th
+    tv, roll, pitch = tv[ok], roll[ok], pitch[ok]
+    dt = float(np.median(np.diff(t)))
+    b, a = butter(1, dt / VERTICAL_TAU_S / math.pi)   # first order, cut-off 1/(2π τ) at the IMU's rate
+    out = []
+    for x, ref in ((phi, roll), (th, pitch)):
+        d = np.interp(t, tv, ref) - x
+        d = d - float(np.mean(d[t < t[0] + _SETTLE_S]))
+        out.append(x + filtfilt(b, a, d, padtype="even"))
+    return out[0], out[1]
+
+
 def read_maneuver(path: str | Path) -> ManeuverRecord:
     """Read one maneuver record (a single maneuver's NetCDF record) into a :class:`ManeuverRecord`."""
     path = str(path)
@@ -120,11 +165,13 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
         raise InputError(path, "record", f"cannot be read as a trial record ({exc}); allowed: a maneuver record "
                          "written by 'vtrials run' (RUN_DIR/records/NAME.nc)") from None
     kinds = instruments_by_kind(rec)
-    trk = kinds.get("gnss", [None])[0] or _need(kinds, "range_radar", path, "positions")
+    # the most accurate satellite fixes the record has (stated accuracy, white and correlated parts)
+    trk = min(kinds.get("gnss", []), key=lambda n: _position_sd(rec.meta(n)), default=None) \
+        or _need(kinds, "range_radar", path, "positions")
     gyro = _need(kinds, "heading", path, "heading")
     imu = _need(kinds, "imu", path, "accelerations and rates")
     rud = _need(kinds, "rudder", path, "rudder angle")
-    rpm = _need(kinds, "shaft_rpm", path, "shaft speed")
+    _need(kinds, "shaft_rpm", path, "shaft speed")
     ev = rec.events
     lab = list(ev["label"])
     if "EXECUTE" not in lab:
@@ -137,6 +184,8 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     w = np.column_stack([rec.channel(imu, c)[1] for c in ("p", "q", "r")])
     im = rec.meta(imu)
     phi, th = _attitude(t, w, f)
+    if kinds.get("attitude"):   # a vertical reference holds the integrated attitude's slow drift
+        phi, th = _vertical_reference(rec, kinds["attitude"][0], t, phi, th)
     # specific force at the reference point: minus the lever arm's tangential and centripetal terms
     arm = np.asarray(im.get("surveyed_position_m", [0.0, 0.0, 0.0]), float)
     wd = np.gradient(w, t, axis=0)
@@ -159,8 +208,7 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     cp_, sp_ = np.cos(psi), np.sin(psi)
     north = north - la[2] * (cp_ * np.sin(tt) * np.cos(ph) + sp_ * np.sin(ph))
     east = east - la[2] * (sp_ * np.sin(tt) * np.cos(ph) - cp_ * np.sin(ph))
-    sig_pos = math.sqrt(float(tm.get("horizontal_accuracy_m", 0.01))**2
-                        + sum(float(s)**2 for s, _ in tm.get("correlated_errors", [])))
+    sig_pos = _position_sd(tm)
     gm = rec.meta(gyro)
     # the gyro's zero against the track on the steady straight approach (calm basin, no current: no
     # drift angle there — the team's assumption, checked in the tests), then its wander over the record
@@ -179,8 +227,16 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     wander2 = float(gm.get("drift_std_rad", 0.0))**2 * min(1.0, 2.0 * (tp[-1] - tp[0]) / tau)
     sig_head = math.sqrt(sig_course**2 + float(gm.get("resolution_rad", 0.0))**2 / 12.0 + wander2)
     heading_sd = math.sqrt(sig_course**2 + wander2 / 3.0)
-    aiding = (NF.Aiding("position", tp, np.column_stack([north, east]), sig_pos, (float(la[0]), float(la[1]))),
-              NF.Aiding("heading", th_h, heading, sig_head))
+    # time stamps: each clock's stated offset from the motion package's moves a fix along the track by
+    # U δt and a heading by ψ̇ δt — nothing on a steady approach, metres and tenths of a degree in a fast
+    # turn; the fixes' and headings' σ carry it (the speed and rate from the motion itself)
+    clk = float(im.get("clock_offset_sd_s", 0.0))
+    dt_pos, dt_head = math.hypot(clk, float(tm.get("clock_offset_sd_s", 0.0))), math.hypot(clk, float(gm.get("clock_offset_sd_s", 0.0)))
+    speed = np.hypot(*np.gradient(np.column_stack([north, east]), tp, axis=0).T) if tp.size > 1 else np.zeros(tp.size)
+    rate_h = np.interp(th_h, t, np.abs(psi_rate))
+    aiding = (NF.Aiding("position", tp, np.column_stack([north, east]), np.hypot(sig_pos, speed * dt_pos),
+                        (float(la[0]), float(la[1]))),
+              NF.Aiding("heading", th_h, heading, np.hypot(sig_head, rate_h * dt_head)))
 
     # the motion package's data sheet → the filter's noise model
     T = float(t[-1] - t[0])
@@ -203,16 +259,31 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     if t.size < 3 or t[0] >= t_exec:
         raise InputError(path, "tracking", f"the first fix is at {tp[0]:.1f} s, after EXECUTE ({t_exec:.1f} s); "
                          "allowed: a record whose tracking starts on the approach")
-    tr, dr = _channel(rec, rud, "angle")
-    tn, nr = _channel(rec, rpm, "rps")
+    p = w[keep, 0]
+    # roll acceleration: the local cubic's slope over ROLL_WINDOW_S (Savitzky & Golay 1964)
+    dt = float(np.median(np.diff(t)))
+    win = max(5, 2 * int(round(ROLL_WINDOW_S / dt / 2)) + 1)
+    pdot = savgol_filter(p, win, 3, deriv=1, delta=dt) if t.size > win else np.gradient(p, t)
+    delta = np.mean([np.interp(t, *_channel(rec, r_, "angle")) for r_ in kinds["rudder"]], axis=0)
+    n = np.mean([np.interp(t, *_channel(rec, s_, "rps")) for s_ in kinds["shaft_rpm"]], axis=0)
+    pitch, pitch_sd = None, 0.0
+    if kinds.get("pitch_indicator"):
+        pis = kinds["pitch_indicator"]
+        pitch = np.mean([np.interp(t, *_channel(rec, i, "pitch")) for i in pis], axis=0)
+        # the zero's stated error, and the hub-oil warming's drift at the power used (its full rise
+        # at the rated power: a bound the team takes as 2 sigma), both common to the record
+        pm = rec.meta(pis[0])
+        pitch_sd = math.hypot(float(pm.get("bias_std", 0.0)),
+                              0.5 * float(pm.get("bias_per_K", 0.0)) * float(pm.get("oil_temperature_rise_K", 0.0)))
     return ManeuverRecord(path=path, name=str(rec.attr("trial", Path(path).stem)), kind=str(rec.attr("kind", "")),
                           ordered=rec.attr("maneuver", {}) or {}, ship=str(rec.attr("ship", "")), t=t, f=f_h,
-                          psi_rate=psi_rate, roll=phi, aiding=aiding, noise=noise, delta=np.interp(t, tr, dr),
-                          n=np.interp(t, tn, nr), t_execute=t_exec, t_finex=t_finex, heading_sd=heading_sd,
+                          psi_rate=psi_rate, roll=phi, aiding=aiding, noise=noise, delta=delta,
+                          n=n, t_execute=t_exec, t_finex=t_finex, heading_sd=heading_sd,
                           rudder_timing_sd=math.hypot(float(rec.meta(rud).get("clock_offset_sd_s", 0.0)),
                                                       float(im.get("clock_offset_sd_s", 0.0))),
                           rudder_sd=float(rec.meta(rud).get("calibration_uncertainty_rad", rec.meta(rud).get("bias_std", 0.0))),
-                          gyro_scale_sd=float(im.get("gyro_scale_sd", 0.0)))
+                          gyro_scale_sd=float(im.get("gyro_scale_sd", 0.0)), p=p, pdot=pdot, pitch=pitch,
+                          pitch_sd=pitch_sd)
 
 
 def reconstruct(mr: ManeuverRecord) -> NF.NavSolution:
@@ -241,5 +312,4 @@ def segment(mr: ManeuverRecord, sol: NF.NavSolution, trim_s: float = 2.0) -> RG.
     """The regression segment of one maneuver: the smoothed record less ``trim_s`` at each end (where
     the smoother has data on one side only)."""
     k = (sol.t >= sol.t[0] + trim_s) & (sol.t <= sol.t[-1] - trim_s)
-    s = RG.Segment.from_nav(sol, mr.delta, mr.n)
-    return RG.Segment(*(getattr(s, f.name)[k] for f in dataclasses.fields(RG.Segment)))
+    return RG.Segment.from_nav(sol, mr.delta, mr.n, mr.roll, mr.p, mr.pdot, mr.pitch).where(k)

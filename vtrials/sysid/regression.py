@@ -19,7 +19,6 @@ import dataclasses
 import numpy as np
 
 from vtrials.errors import InputError
-from vtrials.sysid import mmg
 
 _WHERE = "vtrials.sysid.regression"
 
@@ -37,15 +36,27 @@ class Segment:
     rdot: np.ndarray
     delta: np.ndarray
     n: np.ndarray
+    phi: np.ndarray | None = None    # heel (rad), roll rate (rad/s), roll acceleration and the propellers'
+    p: np.ndarray | None = None      # pitch ratio: the 4-DOF model's inputs (None for a 3-DOF model)
+    pdot: np.ndarray | None = None
+    pitch: np.ndarray | None = None
 
     @classmethod
-    def from_nav(cls, sol, delta, n) -> "Segment":
-        """From a :class:`vtrials.sysid.navfilter.NavSolution` and the rudder angle (rad) and shaft
-        rate (1/s) resampled at its instants."""
+    def from_nav(cls, sol, delta, n, phi=None, p=None, pdot=None, pitch=None) -> "Segment":
+        """From a :class:`vtrials.sysid.navfilter.NavSolution` and the rudder angle (rad), shaft rate
+        (1/s) and, for a 4-DOF model, heel, roll rate, roll acceleration and pitch ratio resampled at its
+        instants."""
         t = np.asarray(sol.t, float)
         delta, n = (np.broadcast_to(np.asarray(a, float), t.shape).copy() for a in (delta, n))
+        roll = [None if a is None else np.broadcast_to(np.asarray(a, float), t.shape).copy()
+                for a in (phi, p, pdot, pitch)]
         return cls(t, sol.state("u"), sol.state("v"), sol.state("r"), sol.acc[:, 0], sol.acc[:, 1],
-                   sol.acc[:, 2], delta, n)
+                   sol.acc[:, 2], delta, n, *roll)
+
+    def where(self, keep) -> "Segment":
+        """The samples selected by ``keep`` (a boolean mask or index array)."""
+        return Segment(*(None if (a := getattr(self, f.name)) is None else a[keep]
+                         for f in dataclasses.fields(Segment)))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,28 +79,30 @@ class Fit:
         return dict(zip(self.terms, self.coef))
 
 
-def hull_force_samples(ship: mmg.Ship, seg: Segment):
-    """Non-dimensional hull forces X'_H, Y'_H, N'_H (inverse dynamics minus known propeller/rudder)."""
-    X, Y, N = mmg.inertial_forces(ship, seg.u, seg.v, seg.r, seg.udot, seg.vdot, seg.rdot)
-    Xpr, Ypr, Npr = mmg.propeller_rudder_forces(ship, seg.u, seg.v, seg.r, seg.delta, seg.n)
-    q = 0.5 * ship.rho * ship.L * ship.d * (seg.u**2 + seg.v**2)
-    return dict(X=(X - Xpr) / q, Y=(Y - Ypr) / q, N=(N - Npr) / (q * ship.L))
+def hull_force_samples(ship, seg: Segment) -> dict:
+    """Hull forces per equation from inverse dynamics less the known parts: non-dimensional for the
+    MMG model (:meth:`vtrials.sysid.mmg.Ship.hull_samples`), in N and N m for the 4-DOF model
+    (:meth:`vtrials.sysid.blanke.Ship4.hull_samples`)."""
+    return ship.hull_samples(seg)
 
 
-def design(ship: mmg.Ship, segments, eq: str, terms, weighted: bool = False):
-    """Stacked regressor matrix and non-dimensional hull-force vector of equation ``eq`` (X, Y or N),
-    and the segment boundaries (for the HAC covariance, which must not lag across maneuvers).
+def design(ship, segments, eq: str, terms, weighted: bool = False):
+    """Stacked regressor matrix and hull-force vector of equation ``eq`` (a key of the ship's
+    structures: X, Y, N, and K for a 4-DOF model), and the segment boundaries (for the HAC covariance,
+    which must not lag across maneuvers).
 
-    ``weighted``: rows scaled by U²/U²_max, i.e. the fit weighs dimensional forces. The errors of
-    reconstructed accelerations are about constant in newtons, so in prime units they grow as 1/U²
-    where a turn has lost half its speed; weighting by U² is the matching weighted least squares."""
-    if eq not in ("X", "Y", "N"):
-        raise InputError(_WHERE, "eq", f"{eq!r}; allowed: X, Y, N")
+    ``weighted``: rows scaled by the ship's row weights over their maximum. For the MMG model these are
+    U²: the errors of reconstructed accelerations are about constant in newtons, so in prime units they
+    grow as 1/U² where a turn has lost half its speed; weighting by U² is the matching weighted least
+    squares (the 4-DOF model fits dimensional forces: unit weights)."""
+    eqs = next(iter(ship.structures.values())).keys()
+    if eq not in eqs:
+        raise InputError(_WHERE, "eq", f"{eq!r}; allowed: {', '.join(eqs)}")
     A, y, w, bounds = [], [], [], [0]
     for seg in segments:
-        A.append(mmg.regressors(terms, seg.u, seg.v, seg.r, ship.L))
+        A.append(ship.regressors(terms, seg))
         y.append(hull_force_samples(ship, seg)[eq])
-        w.append(seg.u**2 + seg.v**2)
+        w.append(ship.row_weights(seg))
         bounds.append(bounds[-1] + len(seg.u))
     A, y = np.vstack(A), np.concatenate(y)
     if weighted:
@@ -171,8 +184,15 @@ def forward_select(ship, segments, eq: str, candidates, required=(), lags: int |
     A_all, y, bounds = design(ship, segments, eq, list(candidates), weighted)
     col = {t: i for i, t in enumerate(candidates)}
 
+    # the models compared share one effective sample size, the whole candidate set's: with each model's
+    # own n_eff the criterion n_eff log(RSS/n) rewards a LOWER n_eff when RSS/n > 1 (forces in newtons)
+    # and a higher one when RSS/n < 1 (prime units), i.e. it would depend on the units
+    n_ref = ols(A_all, y, list(candidates), bounds, lags).n_eff
+
     def fit(ts):
-        return ols(A_all[:, [col[t] for t in ts]], y, ts, bounds, lags)
+        f = ols(A_all[:, [col[t] for t in ts]], y, ts, bounds, lags)
+        rss = f.rms**2 * f.n
+        return dataclasses.replace(f, bic=float(n_ref * np.log(rss / f.n) + len(ts) * np.log(n_ref)))
 
     def admissible(f):
         return min_t is None or all(abs(c) >= min_t * sg for k, c, sg in zip(f.terms, f.coef, f.sigma())
@@ -193,15 +213,16 @@ def forward_select(ship, segments, eq: str, candidates, required=(), lags: int |
 
 def identify(ship, segments, structure: str = "mmg", select: bool = True, lags: int | str = 20,
              min_t: float | None = None, weighted: bool = False) -> dict:
-    """Fit the hull terms of ``structure`` (a key of :data:`mmg.STRUCTURES`) to all segments.
+    """Fit the hull terms of ``structure`` (a key of the ship's structures, e.g. :data:`mmg.STRUCTURES`)
+    to all segments.
 
-    With ``select`` the terms are chosen by forward BIC selection (constant X_0 and the linear
-    derivatives always kept). Returns {eq: Fit}."""
-    if structure not in mmg.STRUCTURES:
-        raise InputError(_WHERE, "structure", f"{structure!r}; allowed: {', '.join(mmg.STRUCTURES)}")
+    With ``select`` the terms are chosen by forward BIC selection (the ship's required terms — the
+    linear derivatives, X_0 or the roll damping — always kept). Returns {eq: Fit}."""
+    if structure not in ship.structures:
+        raise InputError(_WHERE, "structure", f"{structure!r}; allowed: {', '.join(ship.structures)}")
     out = {}
-    for eq, terms in mmg.STRUCTURES[structure].items():
-        req = tuple(t for t in terms if t in mmg.LINEAR or t == "X_0")
+    for eq, terms in ship.structures[structure].items():
+        req = tuple(t for t in terms if t in ship.required)
         if select:
             out[eq] = forward_select(ship, segments, eq, terms, req, lags, min_t, weighted)
         else:
@@ -225,7 +246,7 @@ def cross_validate(ship, segments, structures=("mmg", "blanke"), select: bool = 
         raise InputError(_WHERE, "segments", f"{len(segments)}; allowed: ≥ 2 maneuvers for cross-validation")
     out = {}
     for s in structures:
-        err = {eq: [] for eq in "XYN"}
+        err = {eq: [] for eq in ship.structures[s]}
         for i in range(len(segments)):
             train = [g for j, g in enumerate(segments) if j != i]
             fits = identify(ship, train, s, select, lags, min_t, weighted)
