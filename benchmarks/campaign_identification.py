@@ -1,11 +1,13 @@
-"""Identification campaign (issue 16): replicates of the KVLCC2 L7 identification agenda, each with its
-own instrument draws, identified from its records and scored against the true model.
+"""Identification campaign (issue 16): replicates of an identification agenda, each with its own
+instrument draws, identified from its records and scored against the true model.
 
-Each replicate runs ``scenarios/kvlcc2_l7_identification.toml`` with a scenario seed spawned from the
-campaign seed (numpy SeedSequence: the same table for any worker count), identifies the hull
-(``vtrials.sysid.identify``, BIC-selected MMG; no cross-validation, to save time) and predicts the
-held-back 35° port turn and 20/20 zig-zags, whose records come from one run of the held-back scenarios (the
-sea is calm, so their truth does not change between replicates; only the identified model does).
+``--ship kvlcc2_l7`` (default): each replicate runs ``scenarios/kvlcc2_l7_identification.toml`` with a
+scenario seed spawned from the campaign seed (numpy SeedSequence: the same table for any worker count),
+identifies the hull (``vtrials.sysid.identify``, BIC-selected MMG; no cross-validation, to save time)
+and predicts the held-back 35° port turn and 20/20 zig-zags, whose records come from one run of the
+held-back scenarios (the sea is calm, so their truth does not change between replicates; only the
+identified model does). ``--ship patrol51``: ``scenarios/patrol51_identification.toml`` (4-DOF Blanke
+model), the held-back 25° port turn and 20/20 zig-zag recorded in each replicate's own run.
 With ``--noise-scale 2`` every instrument's stated errors (noise, biases, drifts, correlated errors) are
 doubled through the scenario's instrument overrides — the records AND the team's stated accuracies,
 as for a worse instrument suite.
@@ -16,6 +18,8 @@ prediction errors; and the growth of the RMS errors from noise ×1 to ×2.
 
     python benchmarks/campaign_identification.py --replicates 100 --workers 2 \
         --out benchmarks/results/campaign_identification.json
+    python benchmarks/campaign_identification.py --ship patrol51 --replicates 100 \
+        --out benchmarks/results/campaign_identification_patrol51.json
     python benchmarks/campaign_identification.py --smoother --replicates 100 \
         --out benchmarks/results/campaign_identification_smoother.json     # states and covariance vs truth
 """
@@ -36,9 +40,6 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-SCENARIO = ROOT / "scenarios" / "kvlcc2_l7_identification.toml"
-HELD_BACK = (ROOT / "scenarios" / "kvlcc2_l7_turning.toml", ROOT / "scenarios" / "kvlcc2_l7_zigzag.toml")
-LINEAR = ("Y_v", "Y_r", "N_v", "N_r")
 
 # the suite of models/kvlcc2_l7/instruments.toml with every stated error doubled (catalogue values x2)
 DOUBLED = """
@@ -91,12 +92,56 @@ bias = { mean = 0.0, sd = 0.5 }
 """
 
 
-def _scenario(seed: int, scale: int, where: Path) -> Path:
-    text = SCENARIO.read_text().replace("seed = 16", f"seed = {seed}", 1)
+# patrol51: its scenario's instrument entries (identification DAQ clock) with every stated error doubled
+# (catalogue values x2), inserted as [instrument.set] tables after each entry's clock line
+DOUBLED_PATROL = {
+    "rtk": 'gauss_markov = { sd = 0.02, tau_s = 60.0 }\nmultipath = { sd = 0.01, tau_s = 5.0 }\nnoise = 0.01',
+    "gyro": 'bias = { mean = 0.0, sd = 0.3 }\ngauss_markov = { sd = 0.16, tau_s = 900.0 }\nnoise = 0.06',
+    "imu": ('accel_bias_ug = { mean = 0.0, sd = 200.0 }\naccel_gauss_markov_ug = { sd = 100.0, tau_s = 100.0 }\n'
+            'accel_noise_mps2 = 0.004\ngyro_bias_dph = { mean = 0.0, sd = 4.0 }\n'
+            'gyro_gauss_markov_dph = { sd = 2.0, tau_s = 300.0 }\ngyro_noise_dps = 0.01\nmisalignment_deg = 0.1'),
+    "vertical_gyro": 'bias = { mean = 0.0, sd = 0.2 }\nnoise = 0.06',
+    "rudder_port": 'bias = { mean = 0.0, sd = 0.24 }\nnoise = 0.06',
+    "rudder_starboard": 'bias = { mean = 0.0, sd = 0.24 }\nnoise = 0.06',
+    "rpm_port": 'bias = { mean = 0.0, sd = 0.5 }',
+    "rpm_starboard": 'bias = { mean = 0.0, sd = 0.5 }',
+    "pitch_port": 'bias = { mean = 0.0, sd = 0.02 }\nbias_per_K = 0.002',
+    "pitch_starboard": 'bias = { mean = 0.0, sd = 0.02 }\nbias_per_K = 0.002',
+}
+
+
+def _double_patrol(text: str) -> str:
+    for name, lines in DOUBLED_PATROL.items():
+        head = f'name = "{name}"\n'
+        i = text.index(head)
+        j = text.index('clock = "gnss_disciplined_clock"\n', i) + len('clock = "gnss_disciplined_clock"\n')
+        if text.startswith("[instrument.set]\n", j):   # the entry has its own set table: add to it
+            j += len("[instrument.set]\n")
+            text = text[:j] + lines + "\n" + text[j:]
+        else:
+            text = text[:j] + "[instrument.set]\n" + lines + "\n" + text[j:]
+    return text
+
+
+SHIPS = {
+    "kvlcc2_l7": {"scenario": ROOT / "scenarios" / "kvlcc2_l7_identification.toml", "seed_line": "seed = 16",
+                  "held_back_scenarios": (ROOT / "scenarios" / "kvlcc2_l7_turning.toml",
+                                          ROOT / "scenarios" / "kvlcc2_l7_zigzag.toml"),
+                  "held_back": ("turn_35_port", "zigzag_20_20_*"), "linear": ("Y_v", "Y_r", "N_v", "N_r"),
+                  "double": lambda text: text + DOUBLED},
+    "patrol51": {"scenario": ROOT / "scenarios" / "patrol51_identification.toml", "seed_line": "seed = 161",
+                 "held_back_scenarios": (), "held_back": ("turn_25_port", "zigzag_20_20_starboard"),
+                 "linear": ("Y_uv", "Y_ur", "N_uv", "N_ur"), "double": _double_patrol},
+}
+
+
+def _scenario(ship: str, seed: int, scale: int, where: Path) -> Path:
+    cfg = SHIPS[ship]
+    text = cfg["scenario"].read_text().replace(cfg["seed_line"], f"seed = {seed}", 1)
     if "seed = %d" % seed not in text:
         raise RuntimeError("the identification scenario's seed line changed; update this script")
     if scale == 2:
-        text += DOUBLED
+        text = cfg["double"](text)
     elif scale != 1:
         raise ValueError("noise scale 1 or 2")
     p = where / f"identification_{scale}_{seed}.toml"
@@ -105,22 +150,26 @@ def _scenario(seed: int, scale: int, where: Path) -> Path:
 
 
 def _replicate(args) -> dict:
-    i, seed, scale, held, tmp = args
+    ship, i, seed, scale, held, tmp = args
     import vtrials
     from vtrials.score.identification import score
     from vtrials.sysid.identify import identify_records
     work = Path(tmp) / f"r{scale}_{i}"
     work.mkdir(parents=True, exist_ok=True)
     try:
-        scn = _scenario(seed, scale, work)
+        scn = _scenario(ship, seed, scale, work)
         vtrials.run(str(scn), str(work / "run"), plot=False)
-        doc = identify_records(sorted((work / "run" / "records").glob("*.nc")), "mmg", True, held, compare=(), with_contributions=False)
+        recs = sorted((work / "run" / "records").glob("*.nc"))
+        if not held:   # held back from the replicate's own run
+            held = [p for p in recs if p.stem in SHIPS[ship]["held_back"]]
+        train = [p for p in recs if p not in held]
+        doc = identify_records(train, None, True, held, compare=(), with_contributions=False)
         sc = score(doc)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     row = {"replicate": i, "seed": seed, "scale": scale, "coefficients": {}, "predictions": sc["predictions"],
            "terms": doc["prediction_model"]["terms"]}
-    for k in LINEAR:
+    for k in SHIPS[ship]["linear"]:
         c, s = doc["coefficients"][k], sc["coefficients"][k]
         row["coefficients"][k] = {"value": c["value"], "lo95": c["lo95"], "hi95": c["hi95"], "truth": s["truth"],
                                   "rel_error": s["rel_error"], "covered": s["covered"]}
@@ -130,7 +179,7 @@ def _replicate(args) -> dict:
 def _smoother(args) -> dict:
     """One replicate's smoother check: every maneuver reconstructed from its records and compared with
     the truth (u, v, r at midship): RMS error and the fraction of samples inside ±1.96 σ."""
-    i, seed, tmp = args
+    ship, i, seed, tmp = args
     import h5py
     import vtrials
     from vtrials.sysid import records as RE
@@ -138,14 +187,15 @@ def _smoother(args) -> dict:
     work.mkdir(parents=True, exist_ok=True)
     out = {"replicate": i, "seed": seed, "states": {}}
     try:
-        vtrials.run(str(_scenario(seed, 1, work)), str(work / "run"), plot=False)
+        vtrials.run(str(_scenario(ship, seed, 1, work)), str(work / "run"), plot=False)
         with h5py.File(work / "run" / "truth.nc") as truth:
             for p in sorted((work / "run" / "records").glob("*.nc")):
                 mr = RE.read_maneuver(p)
                 sol = RE.reconstruct(mr)
                 g = truth[mr.name]
+                c = np.cos(np.interp(sol.t, g["time"][:], g["roll"][:]))   # levelled frame: v, r ÷ cos φ
                 for k, col in (("u", "u_r"), ("v", "v_r"), ("r", "r")):
-                    e = sol.state(k) - np.interp(sol.t, g["time"][:], g[col][:])
+                    e = sol.state(k) - np.interp(sol.t, g["time"][:], g[col][:]) / (1.0 if k == "u" else c)
                     out["states"].setdefault(k, []).append(
                         (float(np.sqrt(np.mean(e**2))), float(np.mean(np.abs(e) <= 1.96 * sol.sigma(k)))))
     finally:
@@ -155,6 +205,7 @@ def _smoother(args) -> dict:
 
 def summarise(rows: list[dict]) -> dict:
     from vtrials.score.coverage import verdict
+    LINEAR = tuple(rows[0]["coefficients"])
     out = {}
     for scale in sorted({r["scale"] for r in rows}):
         rs = [r for r in rows if r["scale"] == scale]
@@ -183,6 +234,7 @@ def summarise(rows: list[dict]) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--ship", choices=tuple(SHIPS), default="kvlcc2_l7")
     ap.add_argument("--replicates", type=int, default=100)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=2016)
@@ -198,18 +250,19 @@ def main(argv=None) -> int:
     seeds = [int(s.generate_state(1)[0] % 2**31) for s in np.random.SeedSequence(a.seed).spawn(a.replicates)]
     with tempfile.TemporaryDirectory() as tmp:
         held = []
-        for scn in HELD_BACK:
+        cfg = SHIPS[a.ship]
+        for scn in cfg["held_back_scenarios"]:
             d = Path(tmp) / scn.stem
             vtrials.run(str(scn), str(d), plot=False)
-            held += sorted((d / "records").glob("turn_35_port.nc")) + sorted((d / "records").glob("zigzag_20_20_*.nc"))
-        jobs = [(i, s, scale, [str(h) for h in held], tmp) for scale in a.noise_scale for i, s in enumerate(seeds)]
+            held += [p for pat in cfg["held_back"] for p in sorted((d / "records").glob(f"{pat}.nc"))]
+        jobs = [(a.ship, i, s, scale, [str(h) for h in held], tmp) for scale in a.noise_scale for i, s in enumerate(seeds)]
         rows = []
         with ProcessPoolExecutor(a.workers) as ex:
             for k, row in enumerate(ex.map(_replicate, jobs)):
                 rows.append(row)
                 if (k + 1) % 10 == 0:
                     print(f"{k + 1}/{len(jobs)} replicates, {time.perf_counter() - t0:.0f} s", flush=True)
-    doc = {"campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
+    doc = {"ship": a.ship, "campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
            "summary": summarise(rows), "rows": rows}
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps(doc, indent=1))
@@ -221,14 +274,14 @@ def _smoother_campaign(a) -> int:
     t0 = time.perf_counter()
     seeds = [int(s.generate_state(1)[0] % 2**31) for s in np.random.SeedSequence(a.seed).spawn(a.replicates)]
     with tempfile.TemporaryDirectory() as tmp, ProcessPoolExecutor(a.workers) as ex:
-        rows = list(ex.map(_smoother, [(i, s, tmp) for i, s in enumerate(seeds)]))
+        rows = list(ex.map(_smoother, [(a.ship, i, s, tmp) for i, s in enumerate(seeds)]))
     summary = {}
     for k in ("u", "v", "r"):
         rms = np.array([x[0] for r in rows for x in r["states"][k]])
         cov = np.array([x[1] for r in rows for x in r["states"][k]])
         summary[k] = {"records": int(rms.size), "median_rms": float(np.median(rms)), "max_rms": float(rms.max()),
                       "mean_coverage": float(cov.mean()), "min_coverage": float(cov.min())}
-    doc = {"campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
+    doc = {"ship": a.ship, "campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
            "smoother": summary, "rows": rows}
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps(doc, indent=1))
