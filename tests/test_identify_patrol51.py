@@ -89,6 +89,26 @@ def test_team_model_matches_the_simulators_forces(ident_run):
                 assert rest < (0.006 if e == "X" else 0.003), (name, e, rest)
 
 
+def test_approach_assumptions_hold_for_the_twin_screw_ship(ident_run):
+    """The team zeroes the rudder synchros and the heading reference on the straight approach, assuming
+    rudders amidships and no drift angle there (twin outward-turning screws, calm water): the truth
+    confirms both (< 0.01°), and the zeroed rudder record matches the true rudder within 4 stated σ."""
+    from vtrials.sysid import records as RE
+    with h5py.File(ident_run / "truth.nc") as f:
+        for name in ("zigzag_10_10_starboard", "turn_25_starboard"):
+            g = f[name]
+            t = g["time"][:]
+            ex = float(np.ravel(g.attrs["execute_time_s"])[0])
+            k = (t > 3.0) & (t < ex)
+            assert abs(np.degrees(np.mean(0.5 * (g["rudder_0"][k] + g["rudder_1"][k])))) < 0.01
+            assert np.degrees(np.abs(np.arctan2(g["v_r"][k], g["u_r"][k])).max()) < 0.01
+            mr = RE.read_maneuver(ident_run / "records" / f"{name}.nc")
+            true = np.interp(mr.t, t, 0.5 * (g["rudder_0"][:] + g["rudder_1"][:]))
+            off = float(np.mean(mr.delta - true))
+            print(name, "rudder zero left", np.degrees(off), "deg; stated", np.degrees(mr.rudder_sd))
+            assert 0 < mr.rudder_sd < np.radians(0.05) and abs(off) < 4 * mr.rudder_sd
+
+
 def test_team_prediction_with_true_coefficients_reproduces_the_simulator(ident_run, identified):
     """The team's 4-DOF RK4 prediction with the TRUE hull coefficients against the simulator's own runs
     of the held-back maneuvers: turn within 1 %, overshoots within 0.2° (the prediction's own error,

@@ -148,6 +148,9 @@ class Device:
         if isinstance(bias, dict) and bias.get("sd"):
             # the stated accuracy of the zero (1σ, SI units of the channel), common to a whole record
             m["bias_std"] = float(bias["sd"]) * self.f
+        if isinstance(self.spec.get("resolution"), (int, float)) and self.spec["resolution"] > 0:
+            # the reading's step (SI): a steady quantity reads a constant step error, not noise
+            m["resolution"] = float(self.spec["resolution"]) * self.f
         return m
 
 

@@ -156,6 +156,32 @@ def _vertical_reference(rec, inst, t, phi, th):
     return out[0], out[1]
 
 
+def _rudders(rec, kinds, t, t_exec, path):
+    """Mean rudder angle at the IMU instants and the record-wide error of its zero (rad).
+
+    A twin-screw, twin-rudder ship (two shaft counters and two rudder synchros in the record: outward-
+    or inward-turning pairs, no propeller side force) holds a straight course in calm water with the
+    rudders amidships, so the team zeroes each synchro on the straight approach (the team's assumption,
+    like the gyro's zero; checked against truth in tests/test_identify_patrol51.py). What is left: the
+    reading's step on the steady approach (resolution/√12) and the readings' scatter over the approach.
+    A single-screw ship needs a little helm against its propeller's side force: its synchros keep
+    their stated calibration uncertainty."""
+    rud = kinds["rudder"]
+    sd0 = float(rec.meta(rud[0]).get("calibration_uncertainty_rad", rec.meta(rud[0]).get("bias_std", 0.0)))
+    series = [_channel(rec, r_, "angle") for r_ in rud]
+    if len(rud) < 2 or len(kinds.get("shaft_rpm", [])) < 2:
+        return np.mean([np.interp(t, *s_) for s_ in series], axis=0), sd0
+    out, var = [], []
+    for r_, (tr, dr) in zip(rud, series):
+        k = (tr > tr[0] + _SETTLE_S) & (tr < t_exec)
+        if k.sum() < 10:
+            raise InputError(path, "approach", f"{k.sum()} rudder readings of {r_} on the steady approach; allowed: "
+                             "an approach of at least 1 s more than the settling time")
+        out.append(np.interp(t, tr, dr - float(np.mean(dr[k]))))
+        var.append(float(rec.meta(r_).get("resolution", 0.0))**2 / 12.0 + float(np.var(dr[k])) / int(k.sum()))
+    return np.mean(out, axis=0), math.sqrt(sum(var)) / len(rud)
+
+
 def read_maneuver(path: str | Path) -> ManeuverRecord:
     """Read one maneuver record (a single maneuver's NetCDF record) into a :class:`ManeuverRecord`."""
     path = str(path)
@@ -226,7 +252,9 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     # whose mean square over the record is a third of its end value's
     wander2 = float(gm.get("drift_std_rad", 0.0))**2 * min(1.0, 2.0 * (tp[-1] - tp[0]) / tau)
     sig_head = math.sqrt(sig_course**2 + float(gm.get("resolution_rad", 0.0))**2 / 12.0 + wander2)
-    heading_sd = math.sqrt(sig_course**2 + wander2 / 3.0)
+    # the approach's steady heading reads one constant step error of the gyro's resolution, which the
+    # zero check takes in whole; in the maneuver the steps average out (uniform: resolution²/12)
+    heading_sd = math.sqrt(sig_course**2 + wander2 / 3.0 + float(gm.get("resolution_rad", 0.0))**2 / 12.0)
     # time stamps: each clock's stated offset from the motion package's moves a fix along the track by
     # U δt and a heading by ψ̇ δt — nothing on a steady approach, metres and tenths of a degree in a fast
     # turn; the fixes' and headings' σ carry it (the speed and rate from the motion itself)
@@ -264,7 +292,7 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     dt = float(np.median(np.diff(t)))
     win = max(5, 2 * int(round(ROLL_WINDOW_S / dt / 2)) + 1)
     pdot = savgol_filter(p, win, 3, deriv=1, delta=dt) if t.size > win else np.gradient(p, t)
-    delta = np.mean([np.interp(t, *_channel(rec, r_, "angle")) for r_ in kinds["rudder"]], axis=0)
+    delta, rudder_sd = _rudders(rec, kinds, t, t_exec, path)
     n = np.mean([np.interp(t, *_channel(rec, s_, "rps")) for s_ in kinds["shaft_rpm"]], axis=0)
     pitch, pitch_sd = None, 0.0
     if kinds.get("pitch_indicator"):
@@ -281,7 +309,7 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
                           n=n, t_execute=t_exec, t_finex=t_finex, heading_sd=heading_sd,
                           rudder_timing_sd=math.hypot(float(rec.meta(rud).get("clock_offset_sd_s", 0.0)),
                                                       float(im.get("clock_offset_sd_s", 0.0))),
-                          rudder_sd=float(rec.meta(rud).get("calibration_uncertainty_rad", rec.meta(rud).get("bias_std", 0.0))),
+                          rudder_sd=rudder_sd,
                           gyro_scale_sd=float(im.get("gyro_scale_sd", 0.0)), p=p, pdot=pdot, pitch=pitch,
                           pitch_sd=pitch_sd)
 
