@@ -120,14 +120,15 @@ def build_parser() -> argparse.ArgumentParser:
                      help="simulated seconds per video second (default: the run in at most 60 s)")
     idf = sub.add_parser("identify", help="identify maneuvering coefficients from maneuver records",
                          description="Reconstruct each maneuver's motion from its records (EKF + RTS smoother), "
-                                     "regress the hull forces of the team's MMG model on it (inverse dynamics with the "
+                                     "regress the hull forces of the team's model (3-DOF MMG or 4-DOF Blanke) on it (inverse dynamics with the "
                                      "known propeller, rudder and added mass), cross-validate model structures, "
                                      "predict the held-back maneuvers, and score all of it against the truth when "
                                      "the ship's model and the runs' results are at hand. Writes identification.json "
                                      "and identification.png to DIR.")
     idf.add_argument("records", nargs="+", metavar="RECORD", help="maneuver records (RUN_DIR/records/*.nc)")
-    idf.add_argument("--model", choices=("mmg", "abkowitz", "blanke"), default="mmg",
-                     help="hull model structure (default mmg, Yasukawa & Yoshimura 2015)")
+    idf.add_argument("--model", choices=("mmg", "abkowitz", "blanke", "blanke4", "blanke3"), default=None,
+                     help="hull model structure of the ship's team model (default: its first — mmg, Yasukawa & "
+                          "Yoshimura 2015, for KVLCC2 L7; blanke4, Blanke & Christensen 1993, for patrol51)")
     idf.add_argument("--out", metavar="DIR", required=True, help="output directory")
     idf.add_argument("--held-back", nargs="+", default=[], metavar="RECORD",
                      help="records of maneuvers to predict (not fitted): turning circles and zig-zags")
@@ -153,12 +154,12 @@ def _identify(args) -> int:
     print(f"identified the {len(doc['coefficients'])} hull terms of {doc['structure']} for {doc['ship']} from "
           f"{len(doc['maneuvers'])} maneuver(s); {sum(len(v) for v in doc['prediction_model']['terms'].values())} "
           "kept for predictions")
-    for k in ("Y_v", "Y_r", "N_v", "N_r"):
+    for k in doc["intervals_checked"]:
         c = doc["coefficients"].get(k)
         if c:
             sc = doc.get("score", {}).get("coefficients", {}).get(k)
-            tail = f"   truth {sc['truth']:+.4f} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
-            print(f"  {k:<5} {c['value']:+.4f}  95 % [{c['lo95']:+.4f}, {c['hi95']:+.4f}]{tail}")
+            tail = f"   truth {sc['truth']:+.5g} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
+            print(f"  {k:<5} {c['value']:+.5g}  95 % [{c['lo95']:+.5g}, {c['hi95']:+.5g}]{tail}")
     for p in doc["predictions"]:
         print(f"  predicted {p['name']}: " + ", ".join(f"{k} {v:.3g}" for k, v in p["predicted"].items()))
     if "score" in doc:

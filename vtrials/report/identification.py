@@ -15,22 +15,31 @@ from vtrials.records.netcdf import atomic_path  # noqa: E402
 def identification_plot(doc: dict, path) -> None:
     sc = doc.get("score")
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.8))
-    terms = [k for k in ("Y_v", "Y_r", "N_v", "N_r") if k in doc["coefficients"]]
-    terms += [k for k in doc["coefficients"] if k not in terms]
+    first = [k for k in doc.get("intervals_checked") or ("Y_v", "Y_r", "N_v", "N_r") if k in doc["coefficients"]]
+    terms = first + [k for k in doc["coefficients"] if k not in first]
+    prime = not str(doc.get("units", "")).startswith("SI")
+    if sc and not prime:   # dimensional terms span eight decades: errors relative to the truth
+        terms = [k for k in terms if sc["coefficients"][k]["truth"] != 0.0]
     y = np.arange(len(terms))
     c = [doc["coefficients"][k] for k in terms]
+    val = np.array([x["value"] for x in c])
+    lo, hi = np.array([x["lo95"] for x in c]), np.array([x["hi95"] for x in c])
     if sc:
         t = np.array([sc["coefficients"][k]["truth"] for k in terms])
-        v = np.array([x["value"] for x in c]) - t
-        lo, hi = np.array([x["lo95"] for x in c]) - t, np.array([x["hi95"] for x in c]) - t
+        scale = np.ones_like(t) if prime else np.abs(t)
+        v, lo, hi = (val - t) / scale, (lo - t) / scale, (hi - t) / scale
         ax[0].axvline(0.0, color="k", lw=0.8)
-        ax[0].set_xlabel("identified − true (non-dimensional), 95 % interval")
-    else:
-        v = np.array([x["value"] for x in c])
-        lo, hi = np.array([x["lo95"] for x in c]), np.array([x["hi95"] for x in c])
+        ax[0].set_xlabel("identified − true " + ("(non-dimensional)" if prime else "over |true|") + ", 95 % interval")
+    elif prime:
+        v = val
         ax[0].set_xlabel("identified value (non-dimensional), 95 % interval")
+    else:
+        scale = np.abs(val)
+        v, lo, hi = val / scale, lo / scale, hi / scale
+        ax[0].set_xlabel("identified value over its magnitude (SI terms), 95 % interval")
     ax[0].errorbar(v, y, xerr=[v - lo, hi - v], fmt="o", ms=4, capsize=3)
-    ax[0].set_xscale("symlog", linthresh=0.01)
+    # linear near zero (prime units up to 0.01; relative errors up to 30 %), logarithmic beyond
+    ax[0].set_xscale("symlog", linthresh=0.01 if prime else 0.3)
     ax[0].set_yticks(y, terms)
     ax[0].invert_yaxis()
     ax[0].set_title(f"{doc['ship']}: hull coefficients ({doc['structure']})")
@@ -54,10 +63,14 @@ def identification_plot(doc: dict, path) -> None:
     cv = doc.get("cross_validation") or {}
     if cv:
         names = list(cv)
-        for j, eq in enumerate("XYN"):
-            ax[2].bar(np.arange(len(names)) + 0.25 * (j - 1), [cv[n][eq] for n in names], 0.25, label=eq)
+        eqs = list(cv[names[0]])
+        w = 0.8 / len(eqs)
+        for j, eq in enumerate(eqs):   # each equation relative to its best structure (N and N m alike)
+            best = min(cv[n][eq] for n in names)
+            ax[2].bar(np.arange(len(names)) + w * (j - (len(eqs) - 1) / 2), [cv[n][eq] / best for n in names], w,
+                      label=eq)
         ax[2].set_xticks(np.arange(len(names)), names)
-        ax[2].set_ylabel("RMS of held-out hull force (non-dimensional)")
+        ax[2].set_ylabel("RMS of held-out hull force / best structure's")
         ax[2].legend(fontsize=8)
         ax[2].set_title("leave-one-maneuver-out cross-validation")
     fig.tight_layout()
