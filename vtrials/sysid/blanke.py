@@ -27,6 +27,7 @@ yaw rate, φ heel (+ starboard down). Equations:
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from types import MappingProxyType
 
@@ -176,12 +177,9 @@ class Ship4:
             [0.0, -m * zg - self.K_vdot, self.I_xx - self.K_pdot, -self.I_xz - self.K_rdot],
             [0.0, m * xg - self.N_vdot, -self.I_xz - self.N_pdot, self.I_zz - self.N_rdot]])
 
+    @functools.cached_property
     def _inverse_mass(self) -> np.ndarray:
-        inv = self.__dict__.get("_Minv")
-        if inv is None:   # cached on the (frozen) instance
-            inv = np.linalg.inv(self.mass_matrix())
-            object.__setattr__(self, "_Minv", inv)
-        return inv
+        return np.linalg.inv(self.mass_matrix())
 
     def centripetal(self, u, v, p, r):
         """The rigid-body velocity terms −C_RB(ν)ν (X, Y, K, N) on the force side, M ν̇ = F + this
@@ -284,15 +282,13 @@ class Ship4:
         """Time derivative of the state (x, y, ψ, u, v, r, φ, p) under the given rudder, shaft rate and
         pitch (level trim: ψ̇ = r/cos φ, φ̇ = p)."""
         _, _, psi, u, v, r, phi, p = (float(a) for a in y)
-        H = [0.0, 0.0, 0.0, 0.0]
-        for term, c in coeffs.items():
-            H["XYKN".index(term[0])] += c * TERMS[term](u, v, r, phi, p)
+        H = hull_forces(coeffs, u, v, r, phi, p)
         H[0] -= float(self.resistance(u))
         P = self.propeller_rudder_forces(u, v, r, delta, n, pitch)
         cen = self.centripetal(u, v, p, r)
         F = np.array([H[i] + float(P[i]) + cen[i] for i in range(4)])
         F[2] -= self.rho * G * self.volume * self.GM * math.sin(phi)
-        ud, vd, pd, rd = self._inverse_mass() @ F
+        ud, vd, pd, rd = self._inverse_mass @ F
         c, s, cf = math.cos(psi), math.sin(psi), math.cos(phi)
         vh = v / cf
         return np.array([u * c - vh * s, u * s + vh * c, r / cf, ud, vd, rd, p, pd])
@@ -305,11 +301,11 @@ def regressor(term: str, u, v, r, phi, p) -> np.ndarray:
     return np.asarray(TERMS[term](*(np.asarray(a, float) for a in (u, v, r, phi, p))), float) * np.ones(np.shape(u))
 
 
-def hull_forces(coeffs: dict, u, v, r, phi, p) -> list:
-    """Hull forces X, Y, K, N from the coefficients given (without the resistance)."""
+def hull_forces(coeffs: dict, u: float, v: float, r: float, phi: float, p: float) -> list:
+    """Hull forces X, Y, K, N (N, N m) at one state from the coefficients given (without the resistance)."""
     out = [0.0, 0.0, 0.0, 0.0]
     for term, c in coeffs.items():
-        out["XYKN".index(term[0])] += c * float(regressor(term, u, v, r, phi, p))
+        out["XYKN".index(term[0])] += c * TERMS[term](u, v, r, phi, p)
     return out
 
 
@@ -334,12 +330,3 @@ def patrol51() -> Ship4:
                  K_pdot=-774000.0, K_rdot=0.0, N_vdot=538000.0, N_pdot=0.0, N_rdot=-38.7e6, z_H=1.15,
                  resistance_speeds=speeds, resistance_values=values, D_P=1.6, t_P=0.06, w_P=0.05,
                  y_P=(-2.4, 2.4), rudders=rudders, rudder_rate=math.radians(5.0))
-
-
-def patrol51_hull() -> dict:
-    """BC93's hull coefficients (docs/ships.md §2), the truth the identification is scored against."""
-    return dict(X_vr=119459.34, Y_uv=-11800.0, Y_ur=131000.0, Y_vv=-3700.0, Y_vr=-794000.0, Y_rv=-182000.0,
-                Y_phiuv=10800.0, Y_phiur=251000.0, Y_phiuu=-74.0, K_uv=9260.0, K_ur=-102000.0, K_vv=29300.0,
-                K_vr=621000.0, K_rv=142000.0, K_phiuv=-8400.0, K_phiur=-196000.0, K_phiuu=-1180.0, K_up=-15500.0,
-                K_pp=-416000.0, K_p=-500000.0, K_phiphiphi=-1153745.998, N_uv=-92000.0, N_ur=-4.71e6, N_rr=-2.02e8,
-                N_rv=-1.56e7, N_phiuv=-214000.0, N_phiur=-4.98e6, N_phiuu=-8000.0)
