@@ -38,6 +38,24 @@ def test_rgb_array_frame_of_each_task(task):
     env.close()
 
 
+def test_frame_in_waves_shows_the_wave_surface():
+    """In waves the sea is drawn as the ship's own wave surface: a frame differs from the same pose in
+    a flat sea, and the wave surface moves with time (another instant, another picture)."""
+    env = ShipEnv("CourseKeeping", "patrol51", sea="waves", render_mode="rgb_array", width=240, height=160)
+    env.reset(seed=4, options={"hs_m": 2.0})
+    for _ in range(5):
+        env.step(np.zeros(1, dtype=np.float32))
+    img = env.render()
+    _not_blank(img)
+    core = env.core
+    flat = env._renderer.frame(core.sim.qpos[0], np.array(core.track[0]), core.L)
+    assert np.mean(np.abs(img.astype(int) - flat.astype(int)).sum(axis=2) > 30) > 0.05
+    comp, t = core.render_waves(0)
+    later = env._renderer.frame(core.sim.qpos[0], np.array(core.track[0]), core.L, waves=(comp, t + 2.0))
+    assert not np.array_equal(img, later)
+    env.close()
+
+
 def test_cli_renders_a_run_to_video(tmp_path):
     from vtrials.cli import main
     from vtrials.physics.simulator import Simulator

@@ -392,9 +392,46 @@ def test_kernel_gusts_from_env():
     assert not np.any(env[21:64])  # the rest of the wind header and the wave header stay free
     p = W.pack_wind(VLCC)
     for t in (0.0, 17.3, 900.0):
-        _, ctx = _run_kernel(p, env, 0.0, 0.0, 0.0, np.eye(3), t)
+        # the step kernel puts the gust into the context (a fresh phasor state: the exact sum)
+        g = np.zeros(W.gust_state_width(64))
+        gust = W.gust_step(env, g, t, 0.05)
+        assert gust == pytest.approx(W.gust_at(*gusts, t), rel=1e-12, abs=1e-12)
+        ctx = np.zeros(L.NCTX)
+        ctx[L.ROT:L.ROT + 9] = np.eye(3).ravel()
+        ctx[W.C_WIND_GUST] = gust
+        W.wind_kernel(p, np.zeros(0), env, ctx, np.zeros(L.NAUX), np.zeros(6))
         assert ctx[W.C_WIND_TRUE_SPEED] == pytest.approx(12.0 + W.gust_at(*gusts, t), rel=1e-12)
         assert ctx[W.C_WIND_REL_SPEED] == pytest.approx(ctx[W.C_WIND_TRUE_SPEED], rel=1e-12)
+
+
+def test_gust_phasor_rotation_follows_the_exact_sum():
+    """gust_step over a time-stepping loop (time accumulated as MuJoCo does, 3.5 resync periods, at
+    the start of a run and a day into one; then the same instant again, a changed step and time set
+    back) against the exact Σ a_k cos(ω_k t + ε_k): within the drift bound GUST_RESYNC · ulp(t) ·
+    Σ a_k ω_k (the rotation steps exactly dt, the accumulated time by fl(t + dt) − t) everywhere;
+    afresh, the exact sum."""
+    rng = np.random.default_rng(8)
+    gusts = W.gust_components("npd", 18.0, 10.0, rng, n_components=64)
+    env = W.pack_wind_env(np.zeros(64), 18.0, 0.0, gusts=gusts)
+    g = np.zeros(W.gust_state_width(64))
+    dt = 0.02
+    n = int(3.5 * W.GUST_RESYNC)
+    for t0 in (0.0, 86400.0):
+        t, worst = t0, 0.0
+        for k in range(n):
+            u = W.gust_step(env, g, t, dt)
+            worst = max(worst, abs(u - W.gust_at(*gusts, t)))
+            if k < n - 1:
+                t += dt
+        bound = W.GUST_RESYNC * np.spacing(t) * float(np.sum(gusts[0] * gusts[1])) + 1e-13
+        assert worst < bound, (t0, worst, bound)
+    assert 0.5 < np.std([W.gust_at(*gusts, x) for x in np.arange(0, 600, 1.0)])  # a real gust, not zeros
+    assert W.gust_step(env, g, t, dt) == u  # the same instant again
+    for t2, dt2 in ((t + 0.05, 0.05), (3.0, 0.05)):  # a changed step; time set back
+        assert W.gust_step(env, g, t2, dt2) == W.gust_at(*gusts, t2) or \
+            abs(W.gust_step(env, g, t2, dt2) - W.gust_at(*gusts, t2)) < 1e-13
+        assert g[W.G_COUNT] == 0.0  # started afresh
+    assert W.gust_step(np.zeros(64), g, 1.0, dt) == 0.0  # no gust components
 
 
 def test_scenario_wind_packs_in_si():

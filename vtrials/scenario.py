@@ -208,9 +208,9 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     waves, _ = read_table(Waves, waves_tab, f, "environment.waves")
     waves.check(f)
     wave_loads, _ = read_table(WaveLoads, loads_tab, f, "environment.wave_loads")
-    if (waves.hs_m > 0.0 or waves.swell_hs_m > 0.0) and not _hydro_path(vessel).is_file():
+    if (waves.hs_m > 0.0 or waves.swell_hs_m > 0.0) and not hydro_path(vessel).is_file():
         raise InputError(f, "environment.waves", f"{vessel.name} has no hydrodynamic database "
-                         f"({_hydro_path(vessel)}) for wave loads")
+                         f"({hydro_path(vessel)}) for wave loads")
     items = table_list(doc.get("maneuver", []), f, "maneuver")
     if not has_agenda and not items:
         raise InputError(f, "maneuver", "expected at least one [[maneuver]] table (or an [agenda])")
@@ -301,7 +301,7 @@ def environment_block(scn: Scenario) -> np.ndarray:
     return pack_wind(scn.wind, env, np.random.default_rng(gust_seed))
 
 
-def _hydro_path(vessel: Vessel) -> Path:
+def hydro_path(vessel: Vessel) -> Path:
     """The ship's BEM database: ``models/<ship>/hydro/<ship>_hydro.nc`` (written by
     :mod:`vtrials.physics.seakeeping.build`)."""
     return Path(vessel.folder) / "hydro" / f"{vessel.name}_hydro.nc"
@@ -333,7 +333,7 @@ def sea_vessel(scn: Scenario, dt: float | None = None, model=None):
         return scn.vessel, 0.0
     from vtrials.physics.seakeeping.database import load_database
     from vtrials.physics.seakeeping.sea_ship import sea_ship
-    db = load_database(_hydro_path(scn.vessel))
+    db = load_database(hydro_path(scn.vessel))
     comp = field.components
     keep = (comp[:, 1] >= 0.5 * db.omega[0]) & (comp[:, 1] <= db.omega[-1])
     var = float(np.sum(comp[:, 0] ** 2))

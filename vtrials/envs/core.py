@@ -30,9 +30,11 @@ from vtrials.units import DEG, KNOT
 # are interpolated linearly)
 LEVER = (("back_emergency", -1.0), ("back_full", -0.8), ("back_2_3", -0.6), ("back_1_3", -0.4), ("stop", 0.0),
          ("ahead_1_3", 0.2), ("ahead_2_3", 0.4), ("standard", 0.6), ("full", 0.8), ("flank", 1.0))
-SEAS = ("calm", "wind", "current", "wind_current")
+SEAS = ("calm", "wind", "current", "wind_current", "waves", "wind_current_waves")
 RUDDER_LEVELS = 11  # discrete rudder orders: −δ_max … δ_max in equal steps
 N_GUSTS = 64  # gust components per ship (NPD spectrum)
+N_WAVES = 60  # wave components per ship (JONSWAP wind sea, cos-2s short-crested; the shipped scenarios use
+#               150-200: fewer keep the env fast; the realization still has the spectrum's variance)
 DEPTH_M = 1.0e4
 # time step per ship model: those of the shipped scenarios (scenarios/*.toml)
 SHIP_DT = {"kvlcc2": 0.05, "patrol51": 0.02}
@@ -51,6 +53,11 @@ class SeaRanges:
     wind_kn: tuple[float, float] = (10.0, 30.0)
     current_kn: tuple[float, float] = (0.5, 2.0)
     gust_spectrum: str = "npd"
+    hs_m: tuple[float, float] = (0.5, 2.5)  # significant wave height of the wind sea (sea states 2-4)
+    # T_p/√H_s [s/√m]: DNV-RP-C205 (2010) §3.5.5.5 gives JONSWAP seas 3.6 ≤ T_p/√H_s ≤ 5, with
+    # γ = exp(5.75 − 1.15 T_p/√H_s) there (γ = 1 from 5 on)
+    tp_per_sqrt_hs: tuple[float, float] = (3.6, 5.0)
+    spreading_s: float = 10.0  # cos-2s exponent of a wind sea (Goda 1985)
 
 
 class ShipBatch:
@@ -111,7 +118,21 @@ class ShipBatch:
         self.env_width = W.env_width(N_GUSTS)
         env0 = np.zeros(self.env_width)
         env0[:base.shape[0]] = base
-        self.sim = Simulator(v, self.n, self.dt, envs=env0, nthread=nthread, record_every=0)
+        # waves: the seakeeping vessel (radiation memory, wave excitation, mean wave forces) built once
+        # for a template seaway of N_WAVES components; each episode's own realization is set per ship
+        self.waves = "waves" in sea
+        sim_vessel = v
+        if self.waves:
+            from vtrials.physics.seakeeping.database import load_database
+            from vtrials.physics.seakeeping.sea_ship import sea_ship
+            from vtrials.scenario import hydro_path
+            from vtrials.physics.forces.added_resistance import snnm_hull
+            self._db = load_database(hydro_path(v))
+            self._snnm = snnm_hull(v)
+            comp0, _ = self._wave_components(np.random.default_rng(0), {})
+            sim_vessel, _ = sea_ship(v, self._db, comp0, self.dt)
+        self.wave_comp = np.zeros((self.n, N_WAVES if self.waves else 0, 6))
+        self.sim = Simulator(sim_vessel, self.n, self.dt, envs=env0, nthread=nthread, record_every=0)
         parts, sites, self.devices, self.dev_index = suite_parts(v)
         self.obs_model = ObservationModel(parts, sites, self.n, self.period, self.max_steps)
         self.rng = [np.random.default_rng() for _ in range(self.n)]
@@ -144,6 +165,29 @@ class ShipBatch:
             pitch = np.full_like(lever, np.nan)
         return rps, pitch
 
+    def render_waves(self, i: int) -> tuple[np.ndarray, float] | None:
+        """(wave components, time) of ship ``i`` for the renderer, None in a sea without waves."""
+        return (self.wave_comp[i], float(self.sim.time[i])) if self.waves else None
+
+    def _wave_components(self, rng: np.random.Generator, d: dict) -> tuple[np.ndarray, dict]:
+        """A wind-sea realization of N_WAVES components (JONSWAP, cos-2s) within the hydrodynamic
+        database's band, and what was drawn (H_s, T_p, γ, direction it comes from; knots/degrees)."""
+        from vtrials.physics.environment.waves import Waves, realize
+        from vtrials.physics.seakeeping.sea_ship import in_database_band
+        r = self.ranges
+        hs = float(d.get("hs_m", rng.uniform(*r.hs_m)))
+        ratio = rng.uniform(*r.tp_per_sqrt_hs)
+        tp = float(d.get("tp_s", ratio * math.sqrt(hs)))
+        ratio = tp / math.sqrt(hs)
+        gamma = math.exp(5.75 - 1.15 * ratio) if ratio < 5.0 else 1.0
+        gamma = min(max(gamma, 1.0), 10.0)
+        frm = float(d.get("wave_from_deg", rng.uniform(0.0, 360.0)))
+        waves = Waves(hs_m=hs, tp_s=tp, gamma=gamma, direction_deg=frm, spreading_s=self.ranges.spreading_s,
+                      n_components=N_WAVES)
+        field = realize(waves, DEPTH_M, rng.spawn(1)[0])
+        comp, _ = in_database_band(self._db, field.components, DEPTH_M)
+        return comp, {"hs_m": hs, "tp_s": tp, "gamma": gamma, "wave_from_deg": frm}
+
     def _sea_block(self, rng: np.random.Generator, opts: dict) -> tuple[np.ndarray, dict]:
         r = self.ranges
         wind = "wind" in self.sea
@@ -166,6 +210,14 @@ class ShipBatch:
         env = W.pack_env(wnd, env, gust_rng)
         out = np.zeros(self.env_width)
         out[:env.shape[0]] = env
+        if self.waves:
+            # a wind sea comes from where the wind blows from (when there is wind)
+            known = {k: float(opts[k]) for k in ("hs_m", "tp_s", "wave_from_deg") if k in opts}
+            if wind and "wave_from_deg" not in known:
+                known["wave_from_deg"] = d["wind_from_deg"]
+            comp, drawn = self._wave_components(rng.spawn(1)[0], known)
+            d.update(drawn)
+            d["wave_components"] = comp
         return out, d
 
     # ------------------------------------------------------------------ episodes
@@ -180,6 +232,12 @@ class ShipBatch:
             rng_sea, rng_task, rng_obs = self.rng[i].spawn(3)
             env, sea = self._sea_block(rng_sea, opts)
             self.sim.env[i] = env
+            if self.waves:
+                from vtrials.physics.seakeeping.sea_ship import seaway_params
+                comp = sea.pop("wave_components")
+                self.wave_comp[i] = comp
+                for name, par in seaway_params(self.vessel, self._db, comp, snnm=self._snnm).items():
+                    self.sim.set_component_params(i, name, par)
             order = opts.get("order") or self.task.orders[int(rng_task.integers(len(self.task.orders)))]
             if order not in self.vessel.telegraph:
                 raise InputError("reset options", "order", f"{order!r} is not a telegraph order of "

@@ -80,7 +80,8 @@ class ShipEnv(gym.Env):
         from vtrials.envs.render import ShipRenderer
         if self._renderer is None:
             self._renderer = ShipRenderer(self.core.sim.model, *self._size)
-        img = self._renderer.frame(self.core.sim.qpos[0], np.array(self.core.track[0]), self.core.L)
+        img = self._renderer.frame(self.core.sim.qpos[0], np.array(self.core.track[0]), self.core.L,
+                                     waves=self.core.render_waves(0))
         if self.render_mode == "human":
             self._renderer.show(img)
             return None

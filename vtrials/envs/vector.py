@@ -87,7 +87,8 @@ class ShipVectorEnv(VectorEnv):
         from vtrials.envs.render import ShipRenderer
         if self._renderer is None:
             self._renderer = ShipRenderer(self.core.sim.model, *self._size)
-        return self._renderer.frame(self.core.sim.qpos[0], np.array(self.core.track[0]), self.core.L)
+        return self._renderer.frame(self.core.sim.qpos[0], np.array(self.core.track[0]), self.core.L,
+                                     waves=self.core.render_waves(0))
 
     def close_extras(self, **kwargs):
         if self._renderer is not None:

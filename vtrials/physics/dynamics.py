@@ -36,6 +36,7 @@ from vtrials.physics import propulsion as PR
 from vtrials.physics.forces import context as L
 from vtrials.physics.forces import registry
 from vtrials.physics.environment.current import E_DEPTH, current_at
+from vtrials.physics.environment.wind import C_WIND_GUST, gust_step
 
 # status codes
 OK, NONFINITE, SPEED_RUNAWAY, ATTITUDE_RUNAWAY, RATE_RUNAWAY = 0, 1, 2, 3, 4
@@ -43,9 +44,11 @@ STATUS_TEXT = {NONFINITE: "non-finite state or acceleration", SPEED_RUNAWAY: "sp
                ATTITUDE_RUNAWAY: "heel or trim beyond the capsize limit",
                RATE_RUNAWAY: "angular rate beyond the runaway limit"}
 
-# nav (per ship, persistent between steps)
+# nav (per ship, persistent between steps); the wind gust's phasor state follows from NV_GUST on
+# (vtrials.physics.environment.wind.gust_step; its length depends on the environment block)
 NV_PSI_U, NV_DN, NV_DE = 0, 1, 2
 NNAV = 4
+NV_GUST = NNAV
 
 # limits vector
 LIM_SPEED, LIM_ANGLE, LIM_RATE = 0, 1, 2
@@ -228,6 +231,7 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
         psi_u = nav[i, NV_PSI_U] + H.wrap(psi - nav[i, NV_PSI_U])
         nav[i, NV_PSI_U] = psi_u
         c[L.DT] = dt
+        c[C_WIND_GUST] = gust_step(e, nav[i, NV_GUST:], t, dt)
         # --- helm: one order for all rudders
         if nr > 0:
             order = H.helm_step(i, t, psi_u, om[2], dt, phases, hs, events, ecount, rud_cmd[i, 0])

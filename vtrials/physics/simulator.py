@@ -28,6 +28,7 @@ from vtrials.physics.forces import context as L
 from vtrials.physics.forces.registry import component_type
 from vtrials.physics.propulsion import (GOVERNED, LOCKED, M_INTEG, M_PITCH, M_SETPOINT, M_TORQUE, MODE_NAMES, NMACH, S_CP,
                          S_DADR, S_FRICTION, S_PITCH_DESIGN, S_PROP)
+from vtrials.physics.environment import wind as W
 from vtrials.physics.environment.current import NENV, Current
 from vtrials.physics.environment.current import pack as pack_env
 from vtrials.units import G, deg
@@ -167,7 +168,9 @@ class Simulator:
         self.pitch_cmd = np.tile(self.shaftp[:, S_PITCH_DESIGN], (self.n, 1))
         self.shaft_mode = np.zeros((self.n, self.ns))
         self.mach = np.zeros((self.n, self.ns, NMACH))
-        self.nav = np.zeros((self.n, DY.NNAV))
+        # nav: unwrapped heading, water drift, then the gust phasors (wind.gust_step) for as many
+        # gust components as the environment blocks can hold
+        self.nav = np.zeros((self.n, DY.NNAV + W.gust_state_width(W.max_gusts(self.env.shape[1]))))
         self.phases, self.hs, self.events, self.ecount = H.new_arrays(self.n)
         self.ctx = np.zeros((self.n, L.NCTX))
         self.aux = np.zeros((self.n, L.NAUX))

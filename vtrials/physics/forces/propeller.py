@@ -171,22 +171,26 @@ def pack(pr: Propeller, index: int, length: float, rho: float, u_floor: float, r
             pr.x_P_prime, pr.C1, pr.C2_pos, pr.C2_neg, *sec, jhi, pd_lo, pd_hi, rotation * pr.backing_side_force,
             *g, g_lo, g_hi, len(kt_t), len(kq_t)]
     assert len(head) == P_TERMS
-    return np.concatenate([np.array(head, dtype=np.float64), kt_t.ravel(), kq_t.ravel(), _powers(kt_t, kq_t)])
+    return np.concatenate([np.array(head, dtype=np.float64), kt_t.ravel(), kq_t.ravel(), _dense(kt_t, kq_t)])
 
 
-def _powers(kt_t: np.ndarray, kq_t: np.ndarray) -> np.ndarray:
-    """Tail of the parameter block: [n_J, n_PD, 0, 1, ..., max(n_J, n_PD) − 1], the whole exponents
-    the terms use (J^0 … J^(n_J−1), (P/D)^0 … (P/D)^(n_PD−1)); the kernel tabulates those powers once
-    per call (exponents read from the block, as the terms' own are)."""
+def _dense(kt_t: np.ndarray, kq_t: np.ndarray) -> np.ndarray:
+    """Tail of the parameter block: [n_J, n_PD, C_T (n_J × n_PD), C_Q (n_J × n_PD)], the terms
+    (C', s, t) of each curve summed into a dense coefficient table by exponent, row major, for the
+    kernel's two-variable Horner evaluation (:func:`own_curve`)."""
     ex = np.concatenate([kt_t[:, 1:3], kq_t[:, 1:3]])
     if np.any(ex < 0) or np.any(ex != np.round(ex)):
         raise ValueError("own-curve exponents must be whole numbers ≥ 0")
     nj = int(ex[:, 0].max()) + 1
     npd = int(ex[:, 1].max()) + 1
-    return np.array([nj, npd, *range(max(nj, npd))], dtype=np.float64)
+    tables = np.zeros((2, nj, npd))
+    for tab, terms in zip(tables, (kt_t, kq_t)):
+        for c, s, t in terms:
+            tab[int(s), int(t)] += c
+    return np.concatenate([[nj, npd], tables.ravel()])
 
 
-# parameter block indices (then the K_T and K_Q terms (C', s, t), then the exponent tail of _powers)
+# parameter block indices (then the K_T and K_Q terms (C', s, t), then the dense tables of _dense)
 (P_IDX, P_L, P_RHO, P_UFLOOR, P_D, P_X, P_Y, P_Z, P_TP, P_TPA, P_WAKE, P_W0, P_XP, P_C1, P_C2P, P_C2N,
  P_KA, P_A0, P_CF, P_RQ, P_ETA, P_JHI, P_PDLO, P_PDHI, P_SIDE, P_G0, P_G1, P_G2, P_GLO, P_GHI, P_NT,
  P_NQ) = range(32)
@@ -216,28 +220,29 @@ def _taper(x, lo, hi, width):
 def own_curve(p, J, pd):
     """K_T, K_Q of the own first-quadrant curve, Σ C' J^s (P/D)^t, for parameter block p.
 
-    The powers J^s and (P/D)^t are raised once each (pow of the same operands as term by term, so
-    the sums are bit-identical to raising every term afresh): ~11 pow calls instead of ~170 for a
-    B-series curve. The exponents come from the block's tail (:func:`_powers`).
+    Evaluated by Horner's rule in both variables over the dense coefficient tables of the block's
+    tail (:func:`_dense`): Σ_s J^s (Σ_t C_st (P/D)^t), no power function and no allocation (a
+    B-series curve is 7 × 7: ~100 multiply-adds where the term-by-term sum raised ~11 powers and
+    tabulated them in an allocated array). Equal to the term-by-term sum to rounding.
     """
     nt = int(p[P_NT])
     nq = int(p[P_NQ])
     o = P_TERMS + 3 * (nt + nq)
     nj = int(p[o])
     npd = int(p[o + 1])
-    pw = np.empty(nj + npd)
-    for e in range(nj):
-        pw[e] = J ** p[o + 2 + e]
-    for e in range(npd):
-        pw[nj + e] = pd ** p[o + 2 + e]
+    bt = o + 2
+    bq = bt + nj * npd
     kt = 0.0
-    for m in range(nt):
-        b = P_TERMS + 3 * m
-        kt += p[b] * pw[int(p[b + 1])] * pw[nj + int(p[b + 2])]
     kq = 0.0
-    for m in range(nq):
-        b = P_TERMS + 3 * nt + 3 * m
-        kq += p[b] * pw[int(p[b + 1])] * pw[nj + int(p[b + 2])]
+    for s in range(nj - 1, -1, -1):
+        it = 0.0
+        iq = 0.0
+        r = s * npd
+        for t in range(npd - 1, -1, -1):
+            it = it * pd + p[bt + r + t]
+            iq = iq * pd + p[bq + r + t]
+        kt = kt * J + it
+        kq = kq * J + iq
     return kt, kq
 
 

@@ -48,14 +48,16 @@ def pack(db, components: np.ndarray, dofs=(0, 1, 2, 3, 4, 5)) -> np.ndarray:
     nb_ = h.size
     mask = np.zeros(6)
     mask[list(dofs)] = 1.0
-    out = [np.array([comp.shape[0], nb_]), mask, h]
-    for a, w, k, cm, sm, eps in comp:
-        X = np.empty((nb_, 6), dtype=complex)
+    # X of every component at its frequency, (n, heading, dof): one interpolation per heading and DOF
+    w = comp[:, 1]
+    Xr = np.empty((comp.shape[0], nb_, 6))
+    Xi = np.empty((comp.shape[0], nb_, 6))
+    for ib in range(nb_):
         for j in range(6):
-            X[:, j] = [np.interp(w, db.omega, db.X[:, ib, j].real) + 1j * np.interp(w, db.omega, db.X[:, ib, j].imag)
-                       for ib in range(nb_)]
-        out += [np.array([a, w, k, cm, sm, eps]), X.real.ravel(), X.imag.ravel()]
-    return np.concatenate(out).astype(np.float64)
+            Xr[:, ib, j] = np.interp(w, db.omega, db.X[:, ib, j].real)
+            Xi[:, ib, j] = np.interp(w, db.omega, db.X[:, ib, j].imag)
+    rows = np.concatenate([comp, Xr.reshape(comp.shape[0], 6 * nb_), Xi.reshape(comp.shape[0], 6 * nb_)], axis=1)
+    return np.concatenate([np.array([comp.shape[0], nb_], dtype=np.float64), mask, h, rows.ravel()])
 
 
 @nb.njit(cache=True, inline="always")
