@@ -27,7 +27,7 @@ from vtrials.trials.crew import Crew
 from vtrials.errors import InputError, SimulationError
 from vtrials.instruments.sea_observation import observe_sea
 from vtrials.records.netcdf import atomic_path, open_record, write_groups
-from vtrials.scenario import Scenario, environment_block, instrument_set, sea_vessel
+from vtrials.scenario import Scenario, environment_block, hydro_path, instrument_set, sea_vessel, wave_field
 from vtrials.runner.outputs import json_clean
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.records.trial import write_record
@@ -44,6 +44,8 @@ class AgendaResult:
     wall_time_s: float
     calm_water: dict  # trial name → list of calm-water truth points per accepted group
     timings: dict = dataclasses.field(default_factory=dict)
+    seaway: np.ndarray | None = None  # the sea's wave components (n, 6), truth for the seakeeping scoring
+    hydro_path: Path | None = None  # the ship's hydrodynamic database (seakeeping truth RAOs)
 
     @property
     def attempts(self):
@@ -121,7 +123,10 @@ def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
         exc.trial_time_s = float(crew.t)
         raise
     timings["calm_water_s"] = time.perf_counter() - t1
-    return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings)
+    field = wave_field(scn)
+    return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings,
+                        seaway=None if field is None else field.components,
+                        hydro_path=hydro_path(vessel) if field is not None else None)
 
 
 def _accepted(crew: Crew, trial: str) -> list:

@@ -49,14 +49,13 @@ def _window_weight(x: np.ndarray) -> np.ndarray:
 class _ShipModel:
     """The simulated ship's linearisation pieces, built once per scenario (speed-dependent parts cached)."""
 
-    def __init__(self, scn):
+    def __init__(self, scn, hydro_path):
         from vtrials.physics.seakeeping.database import load_database
         from vtrials.physics.seakeeping.sea_ship import sea_ship
         from vtrials.physics.seakeeping.timedomain import roll_damping_of
-        from vtrials.scenario import hydro_path
         self.scn = scn
         self.ves = scn.vessel
-        self.db = load_database(hydro_path(scn.vessel))
+        self.db = load_database(hydro_path)
         self.dt = scn.head.timestep_s
         self.v0, _ = sea_ship(scn.vessel, self.db, np.zeros((0, 6)), self.dt, mean_force="none")
         self.rd = roll_damping_of(scn.vessel, self.db)
@@ -191,13 +190,11 @@ def _score_tf(red: dict, tru: dict, wb: np.ndarray, coh_min: float, omega_min: f
 
 def score_seakeeping(reduced: dict, res, name: str) -> dict:
     """Per leg: the true transfer functions and motions, the errors and coverage (module doc)."""
-    from vtrials.scenario import wave_field
     from vtrials.score.trials import _truth_of
     scn = res.scenario
     truth = _truth_of(res.crew, name)
-    field = wave_field(scn)
-    comp = field.components
-    model = _ShipModel(scn)
+    comp = np.asarray(res.seaway, float)
+    model = _ShipModel(scn, res.hydro_path)
     iset = res.crew.iset
     probe = [d for d in iset.devices.values() if d.kind == "wave_probe"]
     imu = [d for d in iset.devices.values() if d.kind == "imu"]
