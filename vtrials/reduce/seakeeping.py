@@ -19,6 +19,10 @@ double integration; spectra use [EXECUTE, FINEX]):
   frequency, with coherence γ² and the random error ε of Bendat & Piersol (2010, Table 9.6,
   :mod:`vtrials.reduce.transfer`). The probe's stated gain accuracy (1σ) is added to ε in quadrature
   for the amplitude (a gain error scales every |Ĥ|); the phase interval is ε alone;
+* the transfer function is reported as determined in the bins where γ² > 0.8, the response spectrum is
+  at least 1 % of its peak (in the tails of a motion spectrum, 1/100 of the peak power and less, the
+  estimate is dominated by what the linear wave-to-motion path does not carry: leakage from the peak,
+  the ship's yaw and sway modulating the probe's footprint, nonlinear forcing) and ω_e > 1.2 ω_c;
 * encounter frequency ↔ wave frequency: a = U cos μ / g with U the log speed and μ the direction the
   waves travel relative to the heading (observed wave direction, gyro heading). Head to beam seas
   (a ≤ 0): each ω_e has one wave frequency. Following and quartering seas (a > 0): below
@@ -47,6 +51,7 @@ OMEGA_C = 0.25  # high-pass corner of the heave double integration [rad/s] (belo
 SEGMENT_S = 120.0  # Welch segment length for a 25-min leg [s]; shorter legs use a quarter of the leg
 RESPONSES = {"heave": "m", "vertical_acc": "m s-2", "roll": "rad", "pitch": "rad"}
 COHERENCE_MIN = 0.8  # bins where the transfer function is reported as determined (issue 13)
+ENERGY_MIN = 0.01  # ... and where the response spectrum holds at least this fraction of its peak
 
 
 def _by_kind(rec: Record) -> dict:
@@ -140,7 +145,9 @@ def reduce_leg(rec: Record, run: dict, kinds: dict) -> dict:
         eps_amp = np.sqrt(eps ** 2 + gain_sd ** 2)
         z = 1.959963984540054
         amp = tf.amplitude
+        det = (tf.coherence > COHERENCE_MIN) & (sp.S >= ENERGY_MIN * np.max(sp.S)) & (sp.omega > 1.2 * OMEGA_C)
         resp[name] = {"units": RESPONSES[name], "rms": _rms(y, fs, nper), "spectrum": sp.S.tolist(),
+                      "determined": det.tolist(),
                       "H_re": tf.H.real.tolist(), "H_im": tf.H.imag.tolist(), "coherence": tf.coherence.tolist(),
                       "error": eps.tolist(), "amp_error": eps_amp.tolist(), "n_d": tf.n_d,
                       "amp_lo95": (amp * (1 - z * eps_amp)).tolist(), "amp_hi95": (amp * (1 + z * eps_amp)).tolist(),

@@ -458,5 +458,8 @@ def write_report(doc: dict, res, out: Path) -> None:
         elif tr["kind"] == "maneuvering":
             figs = _mv_figures(tr, res, out)
             L += _mv_markdown(tr, figs)
+        elif tr["kind"] == "seakeeping":
+            from vtrials.report import seakeeping_report as SKR
+            L += SKR.markdown(tr, SKR.figures(tr, out))
     with atomic_path(out / "report.md") as tmp:
         tmp.write_text("\n".join(L) + "\n")
