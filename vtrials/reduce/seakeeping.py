@@ -17,8 +17,14 @@ double integration; spectra use [EXECUTE, FINEX]):
   probe's H_s = 4√m0 (m0 is the same on either frequency axis);
 * transfer functions Ĥ₁ = Ĝ_xy/Ĝ_xx from the probe elevation x to each response y in encounter
   frequency, with coherence γ² and the random error ε of Bendat & Piersol (2010, Table 9.6,
-  :mod:`vtrials.reduce.transfer`). The probe's stated gain accuracy (1σ) is added to ε in quadrature
-  for the amplitude (a gain error scales every |Ĥ|); the phase interval is ε alone;
+  :mod:`vtrials.reduce.transfer`). The 95 % intervals take Student's t with 2n_d − 2 degrees of
+  freedom instead of the normal quantile: for Gaussian records the error of Ĥ₁ along any direction of
+  the complex plane, divided by its estimated standard deviation, is t-distributed with 2n_d − 2
+  degrees of freedom (Goodman 1957, the distribution behind Bendat & Piersol's eq. 9.90); a 6-min leg
+  with 90-s segments has n_d ≈ 6 (t = 2.25, the normal 1.96 covers ~91 %). The probe's stated gain accuracy (1σ) is added to ε in quadrature
+  for the amplitude (a gain error scales every |Ĥ|); the phase adds the relative timing uncertainty of
+  the two loggers' stamps, σ_φ² = ε² + (ω_e σ_τ)², σ_τ² = Σ over both instruments of the stated clock
+  offset sd² + (drift sd × time since synchronisation)² (the record's clock metadata);
 * the transfer function is reported as determined in the bins where γ² > 0.8, the response spectrum is
   at least 1 % of its peak (in the tails of a motion spectrum, 1/100 of the peak power and less, the
   estimate is dominated by what the linear wave-to-motion path does not carry: leakage from the peak,
@@ -39,6 +45,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import stats
 
 from vtrials.records.netcdf import Record
 from vtrials.reduce import encounter as ENC
@@ -73,6 +80,18 @@ def _interp(rec: Record, inst: str, ch: str, t: np.ndarray, angular: bool = Fals
 def segment_length(duration_s: float) -> float:
     """Welch segment length [s] for a leg of ``duration_s``: 120 s, or a quarter of a shorter leg."""
     return min(SEGMENT_S, 0.25 * duration_s)
+
+
+def timing_sd(rec: Record, names, t: float) -> float:
+    """Standard deviation [s] of the difference between the time stamps of instruments ``names`` at
+    time t from their stated clock accuracy (offset, drift since synchronisation; independent clocks)."""
+    var = 0.0
+    for n in names:
+        m = rec.meta(n)
+        off = float(m.get("clock_offset_sd_s", 0.0) or 0.0)
+        drift = float(m.get("clock_drift_ppm_sd", 0.0) or 0.0) * 1e-6 * (t - float(m.get("clock_t_ref_s", 0.0) or 0.0))
+        var += off * off + drift * drift
+    return math.sqrt(var)
 
 
 def _rms(x: np.ndarray, fs: float, nper: int) -> dict:
@@ -137,21 +156,26 @@ def reduce_leg(rec: Record, run: dict, kinds: dict) -> dict:
         out["ambiguous"] = amb.tolist()
         out["omega_wave"] = np.where(amb, np.nan, W[:, 0] if a <= 0 else np.where(np.isfinite(W[:, 0]), W[:, 0], W[:, 2])).tolist()
     resp = {}
+    tmid = 0.5 * (t0 + t1)
+    source = {"heave": imu, "vertical_acc": imu, "roll": vg, "pitch": vg}
     for name, y in series.items():
+        s_tau = timing_sd(rec, (probe, source[name]), tmid)
         y = y - np.mean(y)
         sp = SPC.response_spectrum(y, fs, nper)
         tf = TF.transfer_function(x, y, fs, nper)
         eps = tf.error
         eps_amp = np.sqrt(eps ** 2 + gain_sd ** 2)
-        z = 1.959963984540054
+        eps_ph = np.sqrt(eps ** 2 + (sp.omega * s_tau) ** 2)
+        z = float(stats.t.ppf(0.975, max(2.0 * tf.n_d - 2.0, 1.0)))
         amp = tf.amplitude
         det = (tf.coherence > COHERENCE_MIN) & (sp.S >= ENERGY_MIN * np.max(sp.S)) & (sp.omega > 1.2 * OMEGA_C)
         resp[name] = {"units": RESPONSES[name], "rms": _rms(y, fs, nper), "spectrum": sp.S.tolist(),
                       "determined": det.tolist(),
                       "H_re": tf.H.real.tolist(), "H_im": tf.H.imag.tolist(), "coherence": tf.coherence.tolist(),
-                      "error": eps.tolist(), "amp_error": eps_amp.tolist(), "n_d": tf.n_d,
+                      "error": eps.tolist(), "amp_error": eps_amp.tolist(), "phase_error": eps_ph.tolist(),
+                      "n_d": tf.n_d, "timing_sd_s": s_tau, "z95": z,
                       "amp_lo95": (amp * (1 - z * eps_amp)).tolist(), "amp_hi95": (amp * (1 + z * eps_amp)).tolist(),
-                      "phase_lo95": (tf.phase - z * eps).tolist(), "phase_hi95": (tf.phase + z * eps).tolist()}
+                      "phase_lo95": (tf.phase - z * eps_ph).tolist(), "phase_hi95": (tf.phase + z * eps_ph).tolist()}
     out["responses"] = resp
     return out
 

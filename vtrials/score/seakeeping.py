@@ -47,6 +47,21 @@ def _window_weight(x: np.ndarray) -> np.ndarray:
     return w * w
 
 
+def binned_transfer(amp, omega_e, H, wb, Ts: float) -> tuple[np.ndarray, np.ndarray]:
+    """(H_true, γ²_true) on Welch bins ``wb`` [rad/s] of segment length ``Ts`` [s] from components of
+    amplitude ``amp`` met at signed encounter frequencies ``omega_e`` with complex transfer functions
+    ``H`` (input → output, e^{+iω_e t} convention): the ratio of the expected Hann-window cross- and
+    auto-spectra (module doc); a component met at ω_e < 0 is recorded at |ω_e| with H conjugated."""
+    amp, we, H = (np.asarray(v) for v in (amp, omega_e, H))
+    x = (np.abs(we)[:, None] - np.asarray(wb, float)[None, :]) * Ts / (2 * math.pi)
+    Wt = _window_weight(x) * (0.5 * np.asarray(amp, float) ** 2)[:, None]  # (n, nb)
+    hp = np.where(we < 0, np.conj(H), H)[:, None]
+    sxx = Wt.sum(axis=0)
+    sxy = (Wt * hp).sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return sxy / sxx, np.abs(sxy) ** 2 / (sxx * (Wt * np.abs(hp) ** 2).sum(axis=0))
+
+
 class _ShipModel:
     """The simulated ship's linearisation pieces, built once per scenario (speed-dependent parts cached)."""
 
@@ -128,17 +143,9 @@ def true_transfer(model: _ShipModel, comp: np.ndarray, ref: dict, leg: dict, pro
     H = {"heave": heave, "vertical_acc": -we ** 2 * heave, "roll": R[:, 3], "pitch": R[:, 4]}
     wb = np.asarray(leg["omega_e"], float)
     Ts = float(leg["segment_s"])
-    x = (np.abs(we)[:, None] - wb[None, :]) * Ts / (2 * math.pi)
-    Wt = _window_weight(x) * (0.5 * comp[:, 0] ** 2)[:, None]  # (n, nb)
-    sxx = Wt.sum(axis=0)
-    out = {"u_r": U, "heading": psi, "sigma_roll_rate": sigma_p, "probe_variance_in_bins": sxx.tolist()}
-    neg = we < 0
+    out = {"u_r": U, "heading": psi, "sigma_roll_rate": sigma_p}
     for name, h in H.items():
-        hp = h * ph
-        hp = np.where(neg, np.conj(hp), hp)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            Ht = (Wt * hp[:, None]).sum(axis=0) / sxx
-            coh = np.abs((Wt * hp[:, None]).sum(axis=0)) ** 2 / (sxx * (Wt * np.abs(hp[:, None]) ** 2).sum(axis=0))
+        Ht, coh = binned_transfer(comp[:, 0], we, h * ph, wb, Ts)
         out[name] = {"H_re": Ht.real.tolist(), "H_im": Ht.imag.tolist(), "coherence": coh.tolist()}
     # the long-crested RAO at the sea's true mean direction (for the plots), where ω_e has one wave frequency
     from vtrials.reduce.encounter import wave_frequencies
@@ -177,9 +184,9 @@ def _score_tf(red: dict, tru: dict, wb: np.ndarray, coh_min: float, omega_min: f
     amp_err = np.abs(H) / np.abs(Ht) - 1.0
     ph_err = np.angle(H * np.conj(Ht))
     lo, hi = np.asarray(red["amp_lo95"]), np.asarray(red["amp_hi95"])
-    eps = np.asarray(red["error"])
+    eps = np.asarray(red["phase_error"])
     cov_a = (lo <= np.abs(Ht)) & (np.abs(Ht) <= hi)
-    cov_p = np.abs(ph_err) <= 1.959963984540054 * eps
+    cov_p = np.abs(ph_err) <= float(red.get("z95", 1.959963984540054)) * eps
     n = int(sel.sum())
     d = {"bins": n, "omega_e": wb[sel].tolist(), "amp_error": amp_err[sel].tolist(), "phase_error": ph_err[sel].tolist(),
          "amp_covered": cov_a[sel].tolist(), "phase_covered": cov_p[sel].tolist(),
