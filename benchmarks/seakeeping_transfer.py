@@ -82,6 +82,7 @@ def main(argv=None) -> int:
     ap.add_argument("--timestep", type=float, default=None, help="override the scenario's time step [s]")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "seakeeping_transfer.json"))
     ap.add_argument("--keep", default=None, help="keep the run's outputs (records, report) in this folder")
+    ap.add_argument("--from-results", default=None, help="summarise an existing run's output folder instead")
     a = ap.parse_args(argv)
     src = Path(a.scenario)
     t0 = time.perf_counter()
@@ -96,8 +97,12 @@ def main(argv=None) -> int:
             path.write_text("\n".join(lines) + "\n")
             print(f"time step {old} -> {a.timestep} s")
         out = Path(a.keep) if a.keep else Path(tmp) / "out"
-        doc = run(path, out, plot=bool(a.keep), progress=print)
-    wall = time.perf_counter() - t0
+        if a.from_results:
+            out = Path(a.from_results)
+        else:
+            run(path, out, plot=bool(a.keep), progress=print)
+        doc = json.loads((out / "results.json").read_text())
+    wall = doc["wall_time_s"] if a.from_results else time.perf_counter() - t0
     res = {"scenario": src.name, "timestep_s": doc["timestep_s"], "seed": doc["seed"], "wall_time_s": wall,
            "timings": doc["timings"], "trial_time_h": doc["agenda"]["total_time_s"] / 3600.0, **summarize(doc)}
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)

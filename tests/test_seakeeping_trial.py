@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from vtrials.cli import main
@@ -74,7 +75,6 @@ def test_true_transfer_of_a_component_sea_is_what_h1_estimates():
     complex H plus direction-like scatter of its phase (so γ² < 1). H₁'s own 95 % intervals
     (Bendat & Piersol) must cover the binned truth in about 95 % of the bins with γ² > 0.8
     (Wilson-interval rule of the house), and the truth must beat the unbinned H at the bin centre."""
-    import numpy as np
     from vtrials.reduce.transfer import transfer_function
     from vtrials.score.coverage import wilson
     from vtrials.score.seakeeping import binned_transfer
@@ -106,3 +106,51 @@ def test_true_transfer_of_a_component_sea_is_what_h1_estimates():
     dph_good = np.abs(np.angle(tf.H * np.conj(Ht)))[sel]
     dph_bad = np.abs(np.angle(tf.H * np.conj(Hbad)))[sel]
     assert np.median(dph_good) < 0.5 * np.median(dph_bad)
+
+
+# ----------------------------------------------------------------------------------- a short simulated trial
+@pytest.fixture(scope="module")
+def short_trial(tmp_path_factory):
+    import json
+    import vtrials
+    out = tmp_path_factory.mktemp("seakeeping")
+    res = vtrials.run(ROOT / "scenarios" / "patrol51_seakeeping_short.toml", out, plot=True)
+    doc = json.loads((out / "results.json").read_text())
+    return res, doc, out
+
+
+def _trial(doc):
+    return [t for t in doc["trials"] if t["kind"] == "seakeeping"][0]
+
+
+def test_short_trial_legs_records_and_report(short_trial):
+    """Every leg steered on its course relative to the OBSERVED wave direction (not the true one), the
+    wave probe and the motion sensors in the record, the report pages written."""
+    from vtrials.records.netcdf import open_record
+    res, doc, out = short_trial
+    rec = open_record(out / "records" / "seakeeping.nc")
+    frm = math.degrees(rec.team["sea_observed"][0]["from_rad"])
+    for a in rec.run_log:
+        want = (frm - WAVE_RELATIVE_DEG[a["maneuver"]["wave_heading"]]) % 360.0
+        assert abs(((a["course_deg"] - want) + 180.0) % 360.0 - 180.0) < 1e-6
+        assert a["accepted"]
+    kinds = {rec.meta(n)["kind"] for n in rec.instruments}
+    assert {"wave_probe", "imu", "attitude"} <= kinds
+    t, eta = rec.channel("bow_probe", "elevation")
+    assert 0.6 < 4.0 * float(np.std(eta)) < 0.9  # the sea's H_s is 0.75 m
+    report = (out / "report.md").read_text()
+    assert "seakeeping star pattern" in report
+    for f in ("seakeeping_polar.png", "seakeeping_rms.png", "seakeeping_tf_run1.png"):
+        assert (out / f).stat().st_size > 10_000
+
+
+def test_short_trial_rms_motions_and_probe_hs(short_trial):
+    """RMS heave (strapdown with orientation, from the IMU), vertical acceleration, roll and pitch of each
+    leg against the true motions of the same window; the probe's H_s interval covers the sea's H_s.
+    10 %: issue 10's RMS requirement (measured: within 7.5 %)."""
+    _, doc, _ = short_trial
+    tr = _trial(doc)
+    for leg in tr["legs"]:
+        assert leg["hs_probe"]["covered"], leg["hs_probe"]
+        for n in ("heave", "vertical_acc", "roll", "pitch"):
+            assert abs(leg["rms"][n]["error"]) <= 0.10, (leg["label"], n, leg["rms"][n])
