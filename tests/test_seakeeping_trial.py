@@ -33,8 +33,8 @@ def _bad(tmp_path, capsys, text):
 @pytest.mark.parametrize("edit, field, words", [
     (lambda s: s.replace('heading = "bow_starboard"', 'heading = "starboard_bow"'), "agenda.trial[0].leg[1].heading",
      "starboard_bow"),
-    (lambda s: s.replace('heading = "beam_port"', 'heading = "beam_port"\nstation_keeping = true'),
-     "agenda.trial[0].leg[2].heading", "station-keeping leg is held head to the sea"),
+    (lambda s: s.replace('heading = "bow_starboard"', 'heading = "bow_starboard"\nstation_keeping = true'),
+     "agenda.trial[0].leg[1].heading", "station-keeping leg is held head to the sea"),
     (lambda s: s.replace('leg_s = 360.0\n\n[[agenda.trial.leg]]\nheading = "bow_starboard"',
                          'leg_s = 10.0\n\n[[agenda.trial.leg]]\nheading = "bow_starboard"'), "agenda.trial[0].leg[0].leg_s",
      "10"),
@@ -47,6 +47,7 @@ def _bad(tmp_path, capsys, text):
      "speed_kn"),
 ])
 def test_bad_seakeeping_agenda(tmp_path, capsys, edit, field, words):
+    assert edit(SHORT) != SHORT, "the edit must change the scenario"
     err = _bad(tmp_path, capsys, edit(SHORT))
     assert field in err and words in err, err
 
@@ -146,11 +147,47 @@ def test_short_trial_legs_records_and_report(short_trial):
 
 def test_short_trial_rms_motions_and_probe_hs(short_trial):
     """RMS heave (strapdown with orientation, from the IMU), vertical acceleration, roll and pitch of each
-    leg against the true motions of the same window; the probe's H_s interval covers the sea's H_s.
-    10 %: issue 10's RMS requirement (measured: within 7.5 %)."""
+    leg against the true motions of the same window (the record's own RMS: what is left is the
+    instruments' error and the strapdown's high-pass: accelerometer noise 0.002 m/s² against 0.1 m/s²,
+    the vertical gyro's 0.03° noise and 0.05° steps against 0.5–4°), within 2 % (measured: 0.25 %); the
+    probe's H_s interval covers the sea's H_s."""
     _, doc, _ = short_trial
     tr = _trial(doc)
     for leg in tr["legs"]:
         assert leg["hs_probe"]["covered"], leg["hs_probe"]
         for n in ("heave", "vertical_acc", "roll", "pitch"):
-            assert abs(leg["rms"][n]["error"]) <= 0.10, (leg["label"], n, leg["rms"][n])
+            assert abs(leg["rms"][n]["error"]) <= 0.02, (leg["label"], n, leg["rms"][n])
+
+
+def test_short_trial_transfer_functions_against_the_truth(short_trial):
+    """Issue 13's acceptance — transfer functions within 10 % of the truth where γ² > 0.8, with intervals
+    that cover — on the 6-min head-seas leg (the 25-min legs: benchmarks/seakeeping_transfer.py).
+
+    How often an estimate lies within 10 % is set by its random error, which on a 6-min leg (n_d ≈ 6
+    averages) is twice that of a 25-min leg; so the share within 10 % is compared with the share the
+    reduction's own random error allows, Σ_b P(|t_ν| ≤ 0.10/ε_b)/n (ν = 2n_d − 2): the measured share
+    may fall short of it by at most two binomial standard deviations. The 95 % amplitude intervals must
+    cover the truth by the house rule (Wilson interval of the coverage contains 0.95, or the coverage
+    lies in [0.90, 0.99]). Heave and vertical acceleration are the same record (a factor −ω_e²): their
+    bins are pooled with pitch's all the same, each response being scored as the report shows it."""
+    from vtrials.score.coverage import wilson
+    _, doc, _ = short_trial
+    tr = _trial(doc)
+    head = [L for L in tr["legs"] if L["label"].startswith("head")][0]
+    n_tot, within, expected, var, covered = 0, 0, 0.0, 0.0, 0
+    for name in ("heave", "vertical_acc", "pitch"):
+        t = head["transfer"][name]
+        assert t["bins"] >= 12, (name, t["bins"])  # the head-seas leg is well determined
+        err = np.abs(np.asarray(t["amp_error"]))
+        n_tot += err.size
+        within += int(np.sum(err <= 0.10))
+        expected += t["expected_within_10pct"] * err.size
+        var += t["expected_within_10pct_var"] * err.size ** 2
+        covered += int(np.sum(t["amp_covered"]))
+        print(f"{name}: {err.size} bins, median |err| {np.median(err):.3f}, within 10 % {np.mean(err <= 0.1):.2f} "
+              f"(random error allows {t['expected_within_10pct']:.2f}), amplitude coverage {t['amp_coverage']:.2f}")
+    assert within >= expected - 2.0 * math.sqrt(var), (within, expected, math.sqrt(var))
+    lo, hi = wilson(covered, n_tot)
+    assert lo <= 0.95 <= hi or 0.90 <= covered / n_tot <= 0.99, (covered, n_tot, lo, hi)
+    # roll in head seas is driven by the oblique waves the bow probe cannot tell apart: no bin is determined
+    assert head["transfer"]["roll"]["bins"] == 0

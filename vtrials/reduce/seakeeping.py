@@ -6,15 +6,16 @@ elevation (a point moving with the ship: the wave the ship meets, in the encount
 package (IMU specific forces and rates at its surveyed site), the vertical gyro (roll, pitch), the
 gyro compass and the speed log, and the team's sea-state observation (mean wave direction).
 
-Per leg, on a common grid at the probe's rate over [COMEX, FINEX] (the approach minute pads the
-double integration; spectra use [EXECUTE, FINEX]):
+Per leg, on a common grid at the probe's rate over [EXECUTE, FINEX] (the double integration runs over
+the leg padded with two minutes of the record on either side, reflected where the record ends):
 
 * heave (up) of the IMU's site by strapdown with orientation: the earth-vertical acceleration from the
   specific-force triad rotated with roll and pitch from the vertical gyro, doubly integrated in the
   frequency domain with a high-pass at ``OMEGA_C`` (:mod:`vtrials.reduce.heave`); the vertical
   acceleration (up) of the same site; roll and pitch;
-* response spectra S(ω_e) and RMS with chi-square 95 % intervals (:mod:`vtrials.reduce.spectra`); the
-  probe's H_s = 4√m0 (m0 is the same on either frequency axis);
+* response spectra S(ω_e) (Welch) and RMS (the record's own, about its mean) with chi-square 95 %
+  intervals of the process value (:mod:`vtrials.reduce.spectra`); the probe's H_s = 4√m0 likewise (m0
+  is the same on either frequency axis);
 * transfer functions Ĥ₁ = Ĝ_xy/Ĝ_xx from the probe elevation x to each response y in encounter
   frequency, with coherence γ² and the random error ε of Bendat & Piersol (2010, Table 9.6,
   :mod:`vtrials.reduce.transfer`). The 95 % intervals take Student's t with 2n_d − 2 degrees of
@@ -54,6 +55,7 @@ from vtrials.reduce import spectra as SPC
 from vtrials.reduce import transfer as TF
 from vtrials.units import G
 
+PAD_S = 120.0  # record kept on either side of a leg for the double integration [s]
 OMEGA_C = 0.25  # high-pass corner of the heave double integration [rad/s] (below the encounter band of the sea)
 SEGMENT_S = 120.0  # Welch segment length for a 25-min leg [s]; shorter legs use a quarter of the leg
 RESPONSES = {"heave": "m", "vertical_acc": "m s-2", "roll": "rad", "pitch": "rad"}
@@ -95,7 +97,10 @@ def timing_sd(rec: Record, names, t: float) -> float:
 
 
 def _rms(x: np.ndarray, fs: float, nper: int) -> dict:
-    v = SPC.variance_estimate(x, fs, nper)
+    """RMS of the leg's record about its mean (the sample value, as seed 004 tabulates it), with the
+    chi-square 95 % interval of the process RMS from the record's equivalent degrees of freedom
+    (:func:`vtrials.reduce.spectra.variance_estimate`)."""
+    v = SPC.VarianceEstimate(float(np.var(x)), SPC.variance_estimate(x, fs, nper).dof)
     lo, hi = v.rms_interval()
     return {"value": v.rms, "lo95": lo, "hi95": hi, "dof": v.dof}
 
@@ -106,16 +111,32 @@ def reduce_leg(rec: Record, run: dict, kinds: dict) -> dict:
     imu = kinds["imu"][0]
     vg = kinds["attitude"][0]
     fs = float(rec.meta(probe).get("nominal_rate_hz", 10.0))
-    t_pad0, t0, t1 = float(run["t_comex"]), float(run["t_execute"]), float(run["t_finex"])
-    n = int(math.floor((t1 - t_pad0) * fs))
-    t = t_pad0 + np.arange(n) / fs
-    roll = _interp(rec, vg, "roll", t)
-    pitch = _interp(rec, vg, "pitch", t)
-    ax, ay, az = (_interp(rec, imu, c, t) for c in ("ax", "ay", "az"))
-    heave = HV.heave_from_accelerometers(ax, ay, az, roll, pitch, fs, OMEGA_C)
-    acc_up = -HV.vertical_acceleration(ax, ay, az, roll, pitch)
+    t0, t1 = float(run["t_execute"]), float(run["t_finex"])
+    # the double integration treats its record as periodic: it runs over the leg padded by PAD_S of the
+    # record on either side (reflected where the record ends), so that its wrap-around transient
+    # stays outside [EXECUTE, FINEX]
+    ti = rec.channel(imu, "az")[0]
+    ta = max(t0 - PAD_S, float(ti[0]))
+    n = int(math.floor((t1 + PAD_S - ta) * fs))
+    tg = ta + np.arange(n) / fs
+    t_last = min(float(ti[-1]), float(rec.channel(vg, "roll")[0][-1]))
+    tm = np.where(tg > t_last, 2.0 * t_last - tg, tg)  # mirror past the end of the record
+    roll = _interp(rec, vg, "roll", tm)
+    pitch = _interp(rec, vg, "pitch", tm)
+    ax, ay, az = (_interp(rec, imu, c, tm) for c in ("ax", "ay", "az"))
+    acc_all = -HV.vertical_acceleration(ax, ay, az, roll, pitch)  # up
+    # past the end of the record the acceleration is reflected oddly (a(t_e + s) = −a(t_e − s) about its
+    # mean): velocity then reflects evenly and the displacement stays continuous and bounded (an even
+    # reflection of the acceleration would make the velocity jump by 2 v(t_e) and the heave ramp)
+    past = tg > t_last
+    a_c = acc_all - np.mean(acc_all[~past])
+    a_c[past] = -a_c[past]
+    heave_all = HV.double_integrate(a_c, fs, OMEGA_C)
+    keep = (tg >= t0) & (tg < t1)
+    t = tg[keep]
+    heave, acc_up, roll, pitch = heave_all[keep], acc_all[keep], roll[keep], pitch[keep]
     eta = _interp(rec, probe, "elevation", t)
-    w = t >= t0
+    w = np.ones(t.size, bool)
     series = {"heave": heave[w], "vertical_acc": acc_up[w] - np.mean(acc_up[w]), "roll": roll[w], "pitch": pitch[w]}
     x = eta[w] - np.mean(eta[w])
     T = float(np.count_nonzero(w)) / fs
@@ -144,7 +165,7 @@ def reduce_leg(rec: Record, run: dict, kinds: dict) -> dict:
            "probe_site_m": rec.meta(probe).get("surveyed_position_m"),
            "imu_site_m": rec.meta(imu).get("surveyed_position_m")}
     out["singular_omega_e"] = 0.25 / a if a > 0 else None
-    hs = SPC.variance_estimate(x, fs, nper)
+    hs = SPC.VarianceEstimate(float(np.var(x)), SPC.variance_estimate(x, fs, nper).dof)
     lo, hi = hs.hs_interval()
     out["hs_probe"] = {"value": hs.hs, "lo95": lo, "hi95": hi, "dof": hs.dof}
     sx = SPC.response_spectrum(x, fs, nper)
