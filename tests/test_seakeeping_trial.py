@@ -13,8 +13,8 @@ from vtrials.cli import main
 from vtrials.trials.agenda import WAVE_RELATIVE_DEG, Run
 from vtrials.trials.seakeeping import leg_course
 
-ROOT = Path(__file__).resolve().parents[1]
-SHORT = (ROOT / "scenarios" / "patrol51_seakeeping_short.toml").read_text()
+SHORT_PATH = Path(__file__).resolve().parent / "data" / "patrol51_seakeeping_short.toml"
+SHORT = SHORT_PATH.read_text()
 
 
 def _bad(tmp_path, capsys, text):
@@ -115,7 +115,7 @@ def short_trial(tmp_path_factory):
     import json
     import vtrials
     out = tmp_path_factory.mktemp("seakeeping")
-    res = vtrials.run(ROOT / "scenarios" / "patrol51_seakeeping_short.toml", out, plot=True)
+    res = vtrials.run(SHORT_PATH, out, plot=True)
     doc = json.loads((out / "results.json").read_text())
     return res, doc, out
 
