@@ -62,23 +62,39 @@ def figures(tr: dict, out: Path) -> list[str]:
         fig.suptitle(f"run {sc['run']}: {sc['label']} — transfer functions from the bow probe's wave "
                      f"(probe-referred phase)")
         names.append(_save(fig, out, f"seakeeping_tf_run{sc['run']}.png"))
-    # polar: legs' headings relative to the waves (radius: ω_e), probe spectra as colour
-    fig = plt.figure(figsize=(6.5, 6.5))
-    ax = fig.add_subplot(projection="polar")
+    # polar: the true directional spectrum with the legs' courses; the legs relative to the waves
+    fig = plt.figure(figsize=(13, 6.5))
+    ds = tr["truth"].get("directional_spectrum")
+    ax = fig.add_subplot(1, 2, 1, projection="polar")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    if ds:
+        th, r = np.meshgrid(np.asarray(ds["from_edges_rad"]), np.asarray(ds["omega_edges"]))
+        S = np.asarray(ds["S"])
+        m = ax.pcolormesh(th, r, S, cmap="Blues", shading="flat")
+        fig.colorbar(m, ax=ax, shrink=0.6, label="S(ω, θ) [m² s/rad²]")
+    for leg in tr["reduced"]["legs"]:
+        if math.isfinite(leg["heading"]):
+            ax.annotate("", xy=(leg["heading"], 2.4), xytext=(0, 0),
+                        arrowprops={"arrowstyle": "->", "color": "C3", "lw": 1.0})
+            ax.text(leg["heading"], 2.55, str(leg["run"]), color="C3", fontsize=8)
+    ax.set_title("true directional spectrum (waves coming from; radius ω [rad/s])\nred: the legs' courses "
+                 "(gyro)", fontsize=9)
+    ax = fig.add_subplot(1, 2, 2, projection="polar")
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
     for leg in tr["reduced"]["legs"]:
         if not math.isfinite(leg["mu"]):
             continue
-        rel = math.pi - leg["mu"]  # direction the waves come from, re the bow (+ starboard)
+        rel = leg["mu"] - math.pi  # direction the waves come from, re the bow (+ starboard)
         wb = _arr(leg["omega_e"])
         S = _arr(leg["probe_spectrum"])
         keep = wb <= 3.0
         ax.scatter(np.full(keep.sum(), rel), wb[keep], c=S[keep], s=12, cmap="viridis")
         ax.annotate(f"{leg['run']}", (rel, 3.1), fontsize=8)
     ax.set_rlim(0, 3.3)
-    ax.set_title("legs: where the waves come from re the bow; radius ω_e [rad/s],\ncolour the probe's "
-                 "encounter spectrum", fontsize=9)
+    ax.set_title("legs: where the waves come from re the bow (observed direction); radius ω_e [rad/s],\n"
+                 "colour: the probe's encounter spectrum", fontsize=9)
     names.append(_save(fig, out, "seakeeping_polar.png"))
     # scatter: reduced vs true RMS motions and probe H_s (normalised), as seed 004's fusion scatter
     fig, ax = plt.subplots(figsize=(7, 4.5))

@@ -259,4 +259,18 @@ def score_seakeeping(reduced: dict, res, name: str) -> dict:
             summary[n] = {"bins": len(errs), "median_abs_amp_error": float(np.median(a)), "max_abs_amp_error": float(a.max()),
                           "within_10pct": float(np.mean(a <= 0.10)), "expected_within_10pct": float(ew),
                           "amp_coverage": float(np.mean(cov)), "phase_coverage": float(np.mean(pcov))}
-    return {"reduced": reduced, "truth": {"hs": hs_true}, "legs": legs, "summary": summary}
+    return {"reduced": reduced, "truth": {"hs": hs_true, "directional_spectrum": directional_spectrum(comp)},
+            "legs": legs, "summary": summary}
+
+
+def directional_spectrum(comp: np.ndarray, n_dir: int = 36, n_omega: int = 30, omega_max: float = 2.5) -> dict:
+    """The sea's directional spectrum S(ω, θ) [m² s/rad/rad] binned from its components: θ the direction
+    the waves come FROM (from north, clockwise) in ``n_dir`` sectors, ω in ``n_omega`` bins up to
+    ``omega_max``; each component's variance a²/2 goes to its bin. ∬ S dω dθ = m0 (of the components
+    below ``omega_max``)."""
+    frm = np.remainder(np.arctan2(comp[:, 4], comp[:, 3]) + math.pi, 2 * math.pi)
+    de = np.linspace(0.0, 2 * math.pi, n_dir + 1)
+    we = np.linspace(0.0, omega_max, n_omega + 1)
+    H, _, _ = np.histogram2d(comp[:, 1], frm, bins=(we, de), weights=0.5 * comp[:, 0] ** 2)
+    S = H / (np.diff(we)[:, None] * np.diff(de)[None, :])
+    return {"omega_edges": we.tolist(), "from_edges_rad": de.tolist(), "S": S.tolist()}
