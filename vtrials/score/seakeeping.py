@@ -89,10 +89,9 @@ class _ShipModel:
             self._jac[key] = (start.u, Jv, Je, Jd, Jc)
         return self._jac[key]
 
-    def raos(self, omega, beta, U: float, helm_limit: float | None = None):
-        """(n, 6) coupled RAOs of components (ω_j, β_j) at U, roll damping linearised for this sea."""
-        from vtrials.physics.seakeeping import linearize as LZ
-        from vtrials.physics.seakeeping.rao import encounter_frequency
+    def linear_parts(self, U: float):
+        """(u, J_ν, J_η, J_δ, J_c, autopilot) of the linearisation at speed U (the ship's own heading
+        autopilot: PID gains and the steering gear's time constant)."""
         u, Jv, Je, Jd, Jc = self.jacobians(U)
         ap = self.ves.autopilot
         auto = (*ap.pid, float(self.ves.steering[0, 2]))
@@ -102,7 +101,7 @@ class _ShipModel:
         """RAOs (n, 6) of every component at heading ψ and speed U, their β, and the roll-rate RMS used."""
         from vtrials.physics.seakeeping import linearize as LZ
         from vtrials.physics.seakeeping.rao import encounter_frequency
-        u, Jv, Je, Jd, Jc, auto = self.raos(None, None, U)
+        u, Jv, Je, Jd, Jc, auto = self.linear_parts(U)
         mu = np.arctan2(comp[:, 4], comp[:, 3])
         beta = np.remainder(mu - psi + math.pi, 2 * math.pi) - math.pi
         n = comp.shape[0]
@@ -156,7 +155,7 @@ def true_transfer(model: _ShipModel, comp: np.ndarray, ref: dict, leg: dict, pro
     W = wave_frequencies(wb, U, beta0)
     unique = ~np.isfinite(W[:, 1]) & np.isfinite(W[:, 0]) & (W[:, 0] >= db.omega[0]) & (W[:, 0] <= db.omega[-1])
     from vtrials.physics.seakeeping import linearize as LZ
-    u, Jv, Je, Jd, Jc, auto = model.raos(None, None, U)
+    u, Jv, Je, Jd, Jc, auto = model.linear_parts(U)
     beq = float(model.rd.stochastic(U, sigma_p)) - float(model.rd.B1(U))
     rao0 = {n: np.full(wb.size, np.nan + 0j) for n in RESP}
     if np.any(unique):
