@@ -28,7 +28,7 @@ Directions μ [rad] are where the waves go TOWARDS, from north (x) clockwise to 
    criterion against the moments' sampling errors. For a buoy, whose data fix the moments up to n = 2,
    N ∈ {1, 2}: N = 1 (a von Mises distribution) meets a₁, b₁; N = 2 meets all four. Each fit solves the
    convex dual min F(λ) = ln ∫ exp(λ·f(μ)) dμ − λ·m̂ + ½ ε Σ λ_k², f = (cos μ, sin μ, cos 2μ, sin 2μ)[:2N],
-   by damped Newton (gradient E_D[f] − m̂ + ελ, Hessian Cov_D[f] + ε I); the tiny ε = 10⁻⁶ only keeps λ
+   by damped Newton (gradient E_D[f] − m̂ + ελ, Hessian Cov_D[f] + ε I); the tiny ε = 10⁻⁹ only keeps λ
    finite when a noisy moment set is not realizable by any density. AIC = Σ_k (m_k(D) − m̂_k)²/σ_k² + 2·2N
    over all four moments, with σ_n² = (1 − r_n²)/ν for a record of ν degrees of freedom (r_n = |a_n + i b_n|;
    assumption, of the order of Long 1980's sampling variances): N = 1 is kept where the second moments do
@@ -167,7 +167,7 @@ def mem(a1, b1, a2, b2, mu):
     return _normalise(np.maximum(D, 0.0), mu)
 
 
-EMEP_EPS = 1e-6  # dual regularisation of the EMEP fit (module doc, 4)
+EMEP_EPS = 1e-9  # dual regularisation of the EMEP fit (module doc, 4)
 
 
 def _emep_fit(m_hat, sig2, F, mu, iterations: int = 100):
