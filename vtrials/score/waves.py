@@ -5,7 +5,8 @@ Per transmitted report (a record of ``record_s`` ending at its time stamp) and p
 
 * H_s: the report's 4 √m0 over its band against the true band H_s (:func:`vtrials.truth.seaway.band_truth`)
   and against the true surface's H_s over the same window at the buoy (:func:`vtrials.truth.seaway.window_hs`);
-* mean direction: the method's S-weighted first moment against the components' (same band), error wrapped
+* mean direction: the method's S-weighted first moment against the components' over the same frequencies
+  (the report's bins the reduction used: those with S above ``min_fraction`` of the peak), error wrapped
   to (−180°, 180°];
 * spreading: the circular spread σ₁ from the same first moments, relative error σ₁/σ₁,true − 1.
 Like with like: both sides are the bulk first circular moment over the same band.
@@ -46,10 +47,15 @@ def score_buoy_reports(times, reports, field, record_s: float, position=None, me
             hw = window_hs(field, position[0], position[1], float(t_end) - record_s, float(t_end), window_rate_hz)
             row["hs_window"] = hw
             row["hs_window_error"] = hs / hw - 1.0 if hw > 0 else math.nan
+        used = None
         for m in methods:
-            *_, md, sg = directional_estimate(fc, m, min_fraction=min_fraction)
-            row[f"{m}_direction_error_deg"] = math.degrees(math.remainder(md - truth["mean_direction_to"], 2 * math.pi))
-            row[f"{m}_spread_error"] = sg / truth["spread"] - 1.0
+            w_used, _, _, _, md, sg = directional_estimate(fc, m, min_fraction=min_fraction)
+            if used is None:  # the frequencies the reduction used (the same for every method)
+                used = band_truth(field, bins=(w_used, dw))
+                row["mean_direction_true_deg"] = math.degrees(used["mean_direction_to"])
+                row["spread_true_deg"] = math.degrees(used["spread"])
+            row[f"{m}_direction_error_deg"] = math.degrees(math.remainder(md - used["mean_direction_to"], 2 * math.pi))
+            row[f"{m}_spread_error"] = sg / used["spread"] - 1.0
         rows.append(row)
     return rows
 

@@ -32,11 +32,20 @@ def _band(field, omega_lo: float, omega_hi: float) -> np.ndarray:
     return (w >= omega_lo) & (w <= omega_hi)
 
 
-def band_truth(field, omega_lo: float = 0.0, omega_hi: float = math.inf) -> dict:
-    """{hs_m, mean_direction_to, spread, m0} of the seaway's components with ω in [omega_lo, omega_hi] [rad/s]."""
+def band_truth(field, omega_lo: float = 0.0, omega_hi: float = math.inf, bins=None) -> dict:
+    """{hs_m, mean_direction_to, spread, m0} of the seaway's components with ω in [omega_lo, omega_hi] [rad/s]
+    — or, with ``bins`` = (centres ω_k, width Δω), in the union of the bins [ω_k − Δω/2, ω_k + Δω/2) (the
+    frequencies a reduction actually used)."""
     if field is None or field.components.shape[0] == 0:
         return {"hs_m": 0.0, "mean_direction_to": math.nan, "spread": math.nan, "m0": 0.0}
-    c = field.components[_band(field, omega_lo, omega_hi)]
+    if bins is not None:
+        centres, width = np.asarray(bins[0], dtype=float), float(bins[1])
+        w = field.components[:, 1]
+        k = np.floor((w - (centres[0] - 0.5 * width)) / width + 1e-12).astype(int)
+        grid = np.round((centres - centres[0]) / width).astype(int)
+        c = field.components[np.isin(k, grid)]
+    else:
+        c = field.components[_band(field, omega_lo, omega_hi)]
     e = 0.5 * c[:, 0] ** 2
     m0 = float(np.sum(e))
     if m0 <= 0.0:
