@@ -199,3 +199,19 @@ def test_buoy_reports_from_a_record(tmp_path):
     hs, mdir, sp = reps[0].bulk()
     assert hs == pytest.approx(ch["hs"][0], rel=1e-12)
     assert mdir == pytest.approx(ch["mean_direction_to"][0], abs=1e-12)
+
+
+def test_observed_sea_from_buoy_reports_has_the_stawave_format():
+    """Two 30-min reports of a JONSWAP (γ = 3.3) sea → one observed system as team["sea_observed"] has it:
+    H_s within 3 of its stated standard errors, T_p within 5 %, direction (from) within 5°, γ in [2, 5]."""
+    from vtrials.reduce.directional import observed_sea
+    field = _field(frm=250.0, s=10.0, tp=9.0, hs=2.0, seed=8)
+    d = _buoy(field, seed=9)
+    _, reps, _ = _reports(d, 2)
+    (sys,) = observed_sea(reps, d.record)
+    assert set(sys) == {"hs_m", "tp_s", "gamma", "from_rad", "hs_rel_std", "tp_rel_std", "from_std_rad"}
+    truth = band_truth(field, reps[0].omega[0], reps[0].omega[-1])
+    assert abs(sys["hs_m"] / truth["hs_m"] - 1.0) < 3.0 * sys["hs_rel_std"]
+    assert sys["tp_s"] == pytest.approx(9.0, rel=0.05)
+    assert abs(math.degrees(math.remainder(sys["from_rad"] - math.radians(250.0), 2 * math.pi))) < 5.0
+    assert 2.0 <= sys["gamma"] <= 5.0

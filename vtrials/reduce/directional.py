@@ -34,7 +34,14 @@ Directions μ [rad] are where the waves go TOWARDS, from north (x) clockwise to 
    assumption, of the order of Long 1980's sampling variances): N = 1 is kept where the second moments do
    not differ from the von Mises ones by more than their errors justify.
 5. Buoy reports (:func:`buoy_reports`): a wave buoy's transmitted spectra (S, a₁, b₁, a₂, b₂ per
-   frequency and per record) read from a trial record, as :class:`FourierCoefficients`.
+   frequency and per record) read from a trial record, as :class:`FourierCoefficients`;
+   :func:`observed_sea` turns the reports of a window into the observed wave system the speed-trial
+   analysis uses (the format of ``team["sea_observed"]``, :mod:`vtrials.reduce.stawave`): H_s = 4√m0 of
+   the averaged spectrum, its peak period (parabolic refinement), the mean direction it comes from, a
+   JONSWAP γ from the peak's height over the Pierson–Moskowitz one of the same H_s and T_p
+   (γ C(γ) = S(ω_p)/S_PM(ω_p), C(γ) ≈ 1 − 0.287 ln γ, DNV-RP-C205 §3.5.5; γ ≤ 1: Pierson–Moskowitz), and
+   the standard error of H_s from the record's sampling variability (ν₀ = T m0²/(π ∫S² dω), Bendat &
+   Piersol 2010 §8.2.1, over the reports' total duration: relative sd of H_s = ½ √(2/ν₀)).
 """
 
 from __future__ import annotations
@@ -258,6 +265,39 @@ def buoy_reports(record, instrument: str) -> tuple[np.ndarray, list[FourierCoeff
     out = [FourierCoefficients(omega, np.asarray(S[i]), *(np.asarray(coef[c][i]) for c in ("a1", "b1", "a2", "b2")),
                                dof) for i in range(np.size(t))]
     return np.asarray(t), out
+
+
+def observed_sea(reports: list[FourierCoefficients], record_s: float) -> list[dict]:
+    """One observed wave system (module doc, 5) from the buoy reports of a window (each of ``record_s`` [s])."""
+    if not reports:
+        return []
+    w = reports[0].omega
+    S = np.mean([r.S for r in reports], axis=0)
+    m0 = float(np.trapezoid(S, w))
+    if not m0 > 0.0:
+        return []
+    A1 = float(np.mean([np.trapezoid(r.S * np.nan_to_num(r.a1), w) for r in reports])) / m0
+    B1 = float(np.mean([np.trapezoid(r.S * np.nan_to_num(r.b1), w) for r in reports])) / m0
+    k = int(np.argmax(S))
+    wp = float(w[k])
+    if 0 < k < w.size - 1:
+        d = S[k - 1] - 2.0 * S[k] + S[k + 1]
+        if d < 0.0:
+            wp += 0.5 * (S[k - 1] - S[k + 1]) / d * float(w[1] - w[0])
+    hs = 4.0 * math.sqrt(m0)
+    s_pm = 0.3125 * hs * hs / wp * math.exp(-1.25)  # Bretschneider / PM at its peak
+    ratio = float(np.max(S)) / s_pm
+    gamma = None
+    if ratio > 1.0:
+        lo, hi = 1.0, 10.0  # γ C(γ) rises monotonically on [1, 10]
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if mid * (1.0 - 0.287 * math.log(mid)) < ratio else (lo, mid)
+        gamma = 0.5 * (lo + hi)
+    nu0 = len(reports) * record_s * m0 * m0 / (math.pi * float(np.trapezoid(S * S, w)))
+    return [{"hs_m": hs, "tp_s": float(TWO_PI / wp), "gamma": gamma, "from_rad": (math.atan2(B1, A1) + math.pi) % TWO_PI,
+             "hs_rel_std": 0.5 * math.sqrt(2.0 / nu0), "tp_rel_std": float((w[1] - w[0]) / wp),
+             "from_std_rad": math.sqrt(2.0 * (1.0 - min(1.0, math.hypot(A1, B1)))) / math.sqrt(0.5 * nu0)}]
 
 
 def directional_estimate(fc: FourierCoefficients, method: str, mu=None, omega_lo: float = 0.0,
