@@ -215,3 +215,30 @@ def test_observed_sea_from_buoy_reports_has_the_stawave_format():
     assert sys["tp_s"] == pytest.approx(9.0, rel=0.05)
     assert abs(math.degrees(math.remainder(sys["from_rad"] - math.radians(250.0), 2 * math.pi))) < 5.0
     assert 2.0 <= sys["gamma"] <= 5.0
+
+
+def test_bad_buoy_settings_name_file_and_field():
+    """A scenario's [instrument.set] for a buoy: position_m must be [north, east]; unknown variants are refused
+    with the allowed values; a buoy needs no hull site."""
+
+    from vtrials.errors import InputError
+    from vtrials.instruments.suite import InstrumentSet
+    from vtrials.physics.vessel import load_vessel
+    from pathlib import Path
+    vessel = load_vessel(Path(__file__).resolve().parents[1] / "models" / "patrol51")
+    site = {"transponders": [[-10000.0, -6000.0], [-10000.0, 6000.0]], "transponder_side": -1.0,
+            "hydrophones": [[-600.0, -800.0], [-600.0, 800.0]], "hydrophone_side": -1.0, "water_depth_m": 200.0,
+            "range_center": [10.0, 20.0]}
+    ok = InstrumentSet(vessel, 1, site, [{"name": "b", "spec": "directional_waverider",
+                                          "set": {"position_m": [100.0, -50.0]}}], "s.toml")
+    assert ok.devices["b"].position.tolist() == [100.0, -50.0] and ok.needs_sea
+    default = InstrumentSet(vessel, 1, site, [{"name": "b", "spec": "directional_waverider"}], "s.toml")
+    assert default.devices["b"].position.tolist() == [10.0, 20.0]
+    with pytest.raises(InputError, match=r"s\.toml.*instrument\[0\]\.set\.position_m.*north, east"):
+        InstrumentSet(vessel, 1, site, [{"name": "b", "spec": "directional_waverider", "set": {"position_m": 5.0}}],
+                      "s.toml")
+    with pytest.raises(InputError, match=r"instrument\[0\]\.measures.*displacements, slopes"):
+        InstrumentSet(vessel, 1, site, [{"name": "b", "spec": "directional_waverider",
+                                         "set": {"measures": "pressure"}}], "s.toml")
+    with pytest.raises(InputError, match=r"instrument\[0\]\.site"):
+        InstrumentSet(vessel, 1, site, [{"name": "m", "spec": "tsk_relative_motion"}], "s.toml")

@@ -114,6 +114,10 @@ def check_setting(key: str, value, catalogue_value, f: str, name: str):
             if k not in fields:
                 raise unknown_key(f, name, k, list(fields))
         return {k: check_value(fields[k], v, f, f"{name}.{k}") for k, v in value.items()}
+    if key == "position_m":  # a sea sensor's deployment point [north, east] (wave buoys)
+        if not (isinstance(value, list) and len(value) == 2):
+            raise InputError(f, name, f"expected [north, east] in metres (two numbers), got {value!r}"[:200])
+        return [check_value(Spec("num", lo=-1e7, hi=1e7), v, f, f"{name}[{k}]") for k, v in enumerate(value)]
     if key in ("range", "update_s"):
         if not (isinstance(value, list) and len(value) == 2):
             raise InputError(f, name, f"expected [low, high] (two numbers, low < high), got {value!r}"[:200])
