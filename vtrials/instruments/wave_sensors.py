@@ -249,10 +249,9 @@ class WaveRadar(SeaDevice):
         m.update({"omega_rad_s": self.omega.tolist(), "directions_to_rad": self.mu.tolist(), "cycle_s": self.cycle,
                   "frequency_resolution_rad_s": self.sig_w, "direction_resolution_rad": self.sig_mu,
                   "spectrum_axes": "time, omega, direction (towards)",
-                  # the maker's figure the team has: H_s is a calibrated signal-to-noise estimate, with the
-                  # calibration's stated scale and scatter (the catalogue's), not a measured height
-                  "hs_scale_nominal": self.k_mean, "hs_scale_sd": self.k_sd,
-                  "hs_run_scatter_sd": float(self.gm.sigma.reshape(-1)[0]), "hs_noise_sd": float(self.white.sd.reshape(-1)[0])})
+                  # what the team knows of the height: a calibrated signal-to-noise estimate, not a measured
+                  # one (its actual calibration error is the truth's: drawn())
+                  "hs_method": "signal-to-noise calibration"})
         return m
 
 
