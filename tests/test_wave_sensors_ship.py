@@ -130,3 +130,17 @@ def test_tactical_imu_unchanged_without_the_new_keys():
     m.reset(np.random.default_rng(1))
     assert "lever_arm_error_m" not in m.drawn() and "lever_arm_survey_sd_m" not in m.meta()
     assert "latency_s" not in m.meta()
+
+
+def test_every_sea_sensor_entry_names_its_source_and_builds():
+    from vtrials.instruments.wave_sensors import WAVE_KINDS
+    cat = load_catalogue()
+    names = [k for k, v in cat.items() if isinstance(v, dict) and v.get("kind") in WAVE_KINDS]
+    assert len(names) >= 6
+    for n in names:
+        spec = dict(cat[n])
+        assert len(spec.get("source", "")) > 40, n
+        d = WAVE_KINDS[spec["kind"]](n, spec, "sea", np.array([10.0, 0.0, -2.0]), {"site": {}})
+        d.attach_sea(None)
+        d.reset(np.random.default_rng(0))
+        assert d.meta()["kind"] == spec["kind"]
