@@ -32,7 +32,10 @@ Directions μ [rad] are where the waves go TOWARDS, from north (x) clockwise to 
    finite when a noisy moment set is not realizable by any density. AIC = Σ_k (m_k(D) − m̂_k)²/σ_k² + 2·2N
    over all four moments, with σ_n² = (1 − r_n²)/ν for a record of ν degrees of freedom (r_n = |a_n + i b_n|;
    assumption, of the order of Long 1980's sampling variances): N = 1 is kept where the second moments do
-   not differ from the von Mises ones by more than their errors justify.
+   not differ from the von Mises ones by more than their errors justify. The diwasp-python port of the
+   DIWASP toolbox (PyPI ``diwasp`` 0.1.1) has an EMEP, but requires wavespectra, xarray and pandas at install
+   and works from sensor cross-spectra with transfer functions; not used (the buoy's five coefficients are
+   all a buoy transmits).
 5. Buoy reports (:func:`buoy_reports`): a wave buoy's transmitted spectra (S, a₁, b₁, a₂, b₂ per
    frequency and per record) read from a trial record, as :class:`FourierCoefficients`;
    :func:`observed_sea` turns the reports of a window into the observed wave system the speed-trial
