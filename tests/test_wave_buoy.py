@@ -242,3 +242,31 @@ def test_bad_buoy_settings_name_file_and_field():
                                          "set": {"measures": "pressure"}}], "s.toml")
     with pytest.raises(InputError, match=r"instrument\[0\]\.site"):
         InstrumentSet(vessel, 1, site, [{"name": "m", "spec": "tsk_relative_motion"}], "s.toml")
+
+
+def test_score_wave_record_scores_buoys_and_radars(tmp_path):
+    """A record with a moored buoy and a radar: the buoy's reports are scored per method (the acceptance
+    holds for EMEP here), the radar's H_s ratio is near its drawn calibration scale."""
+    import json
+    from vtrials.instruments.wave_sensors import WaveRadar
+    from vtrials.score.waves import score_wave_record
+    field = _field(seed=12)
+    b = _buoy(field, seed=13)
+    rspec = dict(load_catalogue()["wave_radar_recalibrated"], n_directions=24, frequencies_hz=[0.03, 0.35, 16])
+    r = WaveRadar("radar", rspec, "sea", np.zeros(3), {})
+    r.attach_sea(field)
+    r.reset(np.random.default_rng(14))
+    groups = {}
+    for d in (b, r):
+        t, ch = d.process({"t": np.arange(0.0, 3605.0, 1.0)})
+        meta = {k: (json.dumps(v) if isinstance(v, (list, dict)) else v) for k, v in d.meta().items()}
+        groups[d.name] = {"time": t, "variables": {c: (ch[c], u, ln) for c, (u, ln) in d.channels.items()},
+                          "attrs": meta}
+    write_groups(tmp_path / "r.nc", groups, {"content": "record"})
+    sc = score_wave_record(Record(tmp_path / "r.nc"), field)
+    assert set(sc) == {"buoy", "radar"}
+    assert sc["buoy"]["EMEP"]["n"] == 2 and sc["buoy"]["EMEP"]["fraction_within"] == 1.0
+    assert abs(sc["buoy"]["hs_window"]["error_mean"]) < 0.03
+    assert sc["radar"]["n"] >= 28
+    assert sc["radar"]["tp_ratio_median"] == pytest.approx(1.0, abs=0.05)
+    assert score_wave_record(Record(tmp_path / "r.nc"), None) == {}

@@ -77,3 +77,33 @@ def summarise(rows: list[dict], methods=METHODS, direction_tol_deg: float = 10.0
         ew = np.array([r["hs_window_error"] for r in rows])
         out["hs_window"] = {"error_mean": float(np.mean(ew)), "error_sd": float(np.std(ew, ddof=1)) if ew.size > 1 else 0.0}
     return out
+
+
+def score_wave_record(record, field) -> dict:
+    """Every sea sensor of one trial record against the true sea: per wave buoy (spectra output) the
+    :func:`summarise` of its reports (the window H_s for a moored buoy at its deployed position), per wave
+    radar the ratio of its 2-min H_s to the seaway's (mean, sd, n) and its median peak period over the
+    seaway's. Empty when the record has no sea sensor (or the sea is calm)."""
+    from vtrials.reduce.directional import buoy_reports
+    from vtrials.truth.seaway import band_truth
+    out = {}
+    if field is None:
+        return out
+    for name in record.instruments:
+        meta = record.meta(name)
+        kind = meta.get("kind")
+        if kind == "wave_buoy" and meta.get("output") == "spectra":
+            t, reps = buoy_reports(record, name)
+            if not reps:
+                continue
+            pos = tuple(meta["deployed_position_m"]) if meta.get("mooring") == "moored" else None
+            out[name] = summarise(score_buoy_reports(t, reps, field, float(meta["record_s"]), position=pos))
+        elif kind == "wave_radar":
+            _, hs = record.channel(name, "hs")
+            _, tp = record.channel(name, "tp")
+            if np.size(hs) == 0:
+                continue
+            r = np.asarray(hs) / band_truth(field)["hs_m"]
+            out[name] = {"hs_ratio_mean": float(np.mean(r)), "hs_ratio_sd": float(np.std(r, ddof=1)) if r.size > 1 else 0.0,
+                         "n": int(r.size), "tp_ratio_median": float(np.nanmedian(tp)) / field.tp_s}
+    return out
