@@ -690,18 +690,21 @@ class WaveProbe(Device):
     incident seaway at the site's horizontal position, a point that moves with the ship — the encounter-
     frame wave input of a seakeeping trial. The simulated sea has no radiated or diffracted waves, so
     the footprint ahead of the stem sees the incident wave; the motion compensation's own errors are
-    lumped into the chain's gain error, noise and resolution. The seaway components are set by
-    :meth:`set_seaway` (calm: elevation 0)."""
+    lumped into the chain's gain error, noise and resolution. The seaway is given by :meth:`attach_sea`
+    (the instrument set's sea-sensing hook; calm: elevation 0)."""
 
     kind = "wave_probe"
+    needs_sea = True
     channels = {"elevation": ("m", "surface elevation at the probe footprint (up)")}
 
     def build(self):
         super().build()
         self.components = np.zeros((0, 6))
 
-    def set_seaway(self, components) -> None:
-        self.components = np.asarray(components, dtype=float).reshape(-1, 6)
+    def attach_sea(self, field) -> None:
+        """The scenario's seaway (a :class:`~vtrials.physics.environment.waves.WaveField`, None: calm)."""
+        comp = np.zeros((0, 6)) if field is None else field.components
+        self.components = np.asarray(comp, dtype=float).reshape(-1, 6)
 
     def measurand(self, kin, cols):
         if self.components.shape[0] == 0 or cols["t"].size == 0:
@@ -722,12 +725,19 @@ class IMU(Device):
     lever-arm centripetal and tangential terms) and rate gyros, each with bias, bias instability
     (Gauss–Markov), bias random walk (rate random walk of the gyros, IEEE Std 952-1997 Annex C
     coefficient K: Allan deviation K √(τ/3); the accelerometers' bias random walk likewise), noise,
-    scale-factor error and a common misalignment."""
+    scale-factor error and a common misalignment (the mounting's angular error).
+
+    Mounting and timing (issue 13, opt-in catalogue keys): ``lever_arm_sd_m`` — the package actually sits
+    N(0, sd²) per body axis away from its surveyed site (drawn per trial; the accelerometers feel the
+    lever-arm terms of the actual position, the record gives the surveyed one); ``latency_s`` — each
+    sample is stamped that long after the instant it describes (the filter and bus delay of the package,
+    :class:`~vtrials.instruments.parts.Latency`); the logger clock's offset and drift are the instrument
+    set's (every instrument has one)."""
 
     kind = "imu"
     extra_keys = {"accel_bias_ug", "accel_gauss_markov_ug", "accel_noise_mps2", "accel_scale", "gyro_bias_dph",
                   "gyro_gauss_markov_dph", "gyro_noise_dps", "gyro_scale", "accel_random_walk_ug_rth",
-                  "gyro_random_walk_dph_rth"}
+                  "gyro_random_walk_dph_rth", "lever_arm_sd_m"}
     channels = {"ax": ("m s-2", "specific force x"), "ay": ("m s-2", "specific force y"),
                 "az": ("m s-2", "specific force z (≈ −g at rest)"), "p": ("rad s-1", "roll rate"),
                 "q": ("rad s-1", "pitch rate"), "r": ("rad s-1", "yaw rate")}
@@ -756,22 +766,37 @@ class IMU(Device):
                             P.RandomWalk(float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0, n_axes=3)])
         self.clock = P.Resample(float(s["rate_hz"]))
         self.chain = P.Chain([self.clock])
+        self.latency = float(s.get("latency_s", 0.0))
+        self.lever_sd = float(s.get("lever_arm_sd_m", 0.0))
+        if not (math.isfinite(self.latency) and self.latency >= 0.0):
+            raise SpecError("latency_s", f"must be finite and >= 0 s, got {s.get('latency_s')!r}")
+        if not (math.isfinite(self.lever_sd) and self.lever_sd >= 0.0):
+            raise SpecError("lever_arm_sd_m", f"must be finite and >= 0 m, got {s.get('lever_arm_sd_m')!r}")
+        self.lever_error = np.zeros(3)
 
     def reset(self, rng):
         r1, r2, r3 = rng.spawn(3)
         self.clock.reset(r1)
         self.acc.reset(r2)
         self.gyr.reset(r3)
+        if self.lever_sd > 0.0:  # a fourth child only when asked: the other draws stay as they were
+            (r4,) = rng.spawn(1)
+            self.lever_error = self.lever_sd * r4.standard_normal(3)
 
     def process(self, cols):
-        kin = SiteKinematics(cols, self.site)
+        kin = SiteKinematics(cols, self.site + self.lever_error)
         t, y = self.clock.process(cols["t"], np.column_stack([kin.specific_force(), kin.omega]))
         _, a = self.acc.process(t, y[:, :3])
         _, w = self.gyr.process(t, y[:, 3:])
+        if self.latency > 0.0:
+            t = t + self.latency
         return t, {"ax": a[:, 0], "ay": a[:, 1], "az": a[:, 2], "p": w[:, 0], "q": w[:, 1], "r": w[:, 2]}
 
     def drawn(self):
-        return {"clock": self.clock.drawn(), "accelerometers": self.acc.drawn(), "gyros": self.gyr.drawn()}
+        d = {"clock": self.clock.drawn(), "accelerometers": self.acc.drawn(), "gyros": self.gyr.drawn()}
+        if self.lever_sd > 0.0 or self.latency > 0.0:
+            d.update(lever_arm_error_m=self.lever_error.tolist(), latency_s=self.latency)
+        return d
 
     def meta(self):
         # the data sheet as the team has it (SI, 1σ): white noise per sample, turn-on bias and its
@@ -789,6 +814,8 @@ class IMU(Device):
                   "gyro_scale_sd": float(s.get("gyro_scale", {}).get("sd", 0.0)),
                   "accel_random_walk": float(s.get("accel_random_walk_ug_rth", 0.0)) * ug / 60.0,
                   "gyro_random_walk": float(s.get("gyro_random_walk_dph_rth", 0.0)) * dph / 60.0})
+        if self.lever_sd > 0.0:
+            m["lever_arm_survey_sd_m"] = self.lever_sd  # how well the installation's position was surveyed
         return m
 
 

@@ -21,7 +21,30 @@ Directions μ [rad] are where the waves go TOWARDS, from north (x) clockwise to 
    c₂ = a₂ + i b₂: φ₁ = (c₁ − c₂ c₁*)/(1 − |c₁|²), φ₂ = c₂ − c₁ φ₁,
        D(μ) = (1/2π)(1 − φ₁ c₁* − φ₂ c₂*)/|1 − φ₁ e^{−iμ} − φ₂ e^{−2iμ}|²,
    which reproduces all five coefficients exactly.
-The extended maximum-entropy principle (EMEP, Hashimoto 1997) is not implemented here.
+4. Extended maximum-entropy principle (EMEP; Hashimoto, Nagai & Asai 1994, Proc. 24th ICCE, "Extension of
+   the maximum entropy principle method for directional wave spectrum estimation"): D is sought in the
+   exponential family D(μ) = exp(Σ_{n=1}^{N} α_n cos nμ + β_n sin nμ)/Z — the Shannon-entropy maximum under
+   moment constraints (Kobune & Hashimoto 1986) — with the order N chosen by Akaike's information
+   criterion against the moments' sampling errors. For a buoy, whose data fix the moments up to n = 2,
+   N ∈ {1, 2}: N = 1 (a von Mises distribution) meets a₁, b₁; N = 2 meets all four. Each fit solves the
+   convex dual min F(λ) = ln ∫ exp(λ·f(μ)) dμ − λ·m̂ + ½ ε Σ λ_k², f = (cos μ, sin μ, cos 2μ, sin 2μ)[:2N],
+   by damped Newton (gradient E_D[f] − m̂ + ελ, Hessian Cov_D[f] + ε I); the tiny ε = 10⁻⁹ only keeps λ
+   finite when a noisy moment set is not realizable by any density. AIC = Σ_k (m_k(D) − m̂_k)²/σ_k² + 2·2N
+   over all four moments, with σ_n² = (1 − r_n²)/ν for a record of ν degrees of freedom (r_n = |a_n + i b_n|;
+   assumption, of the order of Long 1980's sampling variances): N = 1 is kept where the second moments do
+   not differ from the von Mises ones by more than their errors justify. The diwasp-python port of the
+   DIWASP toolbox (PyPI ``diwasp`` 0.1.1) has an EMEP, but requires wavespectra, xarray and pandas at install
+   and works from sensor cross-spectra with transfer functions; not used (the buoy's five coefficients are
+   all a buoy transmits).
+5. Buoy reports (:func:`buoy_reports`): a wave buoy's transmitted spectra (S, a₁, b₁, a₂, b₂ per
+   frequency and per record) read from a trial record, as :class:`FourierCoefficients`;
+   :func:`observed_sea` turns the reports of a window into the observed wave system the speed-trial
+   analysis uses (the format of ``team["sea_observed"]``, :mod:`vtrials.reduce.stawave`): H_s = 4√m0 of
+   the averaged spectrum, its peak period (parabolic refinement), the mean direction it comes from, a
+   JONSWAP γ from the peak's height over the Pierson–Moskowitz one of the same H_s and T_p
+   (γ C(γ) = S(ω_p)/S_PM(ω_p), C(γ) ≈ 1 − 0.287 ln γ, DNV-RP-C205 §3.5.5; γ ≤ 1: Pierson–Moskowitz), and
+   the standard error of H_s from the record's sampling variability (ν₀ = T m0²/(π ∫S² dω), Bendat &
+   Piersol 2010 §8.2.1, over the reports' total duration: relative sd of H_s = ½ √(2/ν₀)).
 """
 
 from __future__ import annotations
@@ -152,6 +175,155 @@ def mem(a1, b1, a2, b2, mu):
     num = (1.0 - p1 * np.conj(c1) - p2 * np.conj(c2)).real
     D = num / (TWO_PI * np.abs(1.0 - p1 * e1 - p2 * e1 * e1) ** 2)
     return _normalise(np.maximum(D, 0.0), mu)
+
+
+EMEP_EPS = 1e-9  # dual regularisation of the EMEP fit (module doc, 4)
+
+
+def _emep_fit(m_hat, sig2, F, mu, iterations: int = 100):
+    """λ (n, k) of D ∝ exp(λ·F(μ)) for target moments m_hat (n, k) with moment variances sig2 (n, k)
+    (module doc, 4): damped Newton on the convex dual, vectorised over rows. F: (k, n_mu)."""
+    n, k = m_hat.shape
+    lam = np.zeros((n, k))
+    dmu = TWO_PI / mu.size
+
+    def dual(lam_):
+        z = lam_ @ F
+        zmax = z.max(axis=1, keepdims=True)
+        w = np.exp(z - zmax)
+        Z = w.sum(axis=1) * dmu
+        return np.log(Z) + zmax[:, 0] - np.sum(lam_ * m_hat, axis=1) + 0.5 * np.sum(sig2 * lam_ ** 2, axis=1), w, Z
+
+    val, w, Z = dual(lam)
+    for _ in range(iterations):
+        D = w / Z[:, None]  # density ×(1/dmu) normalisation folded: Σ D dmu = 1
+        E = D @ F.T * dmu
+        cov = np.einsum("nm,km,lm->nkl", D, F, F) * dmu - E[:, :, None] * E[:, None, :]
+        g = E - m_hat + sig2 * lam
+        H = cov + np.einsum("nk,kl->nkl", sig2 + 1e-12, np.eye(k))
+        step = np.linalg.solve(H, g[:, :, None])[:, :, 0]
+        t = np.ones(n)
+        for _ls in range(30):  # backtracking: accept where the dual decreases
+            cand = lam - t[:, None] * step
+            v2, w2, Z2 = dual(cand)
+            ok = v2 <= val + 1e-14
+            if np.all(ok):
+                break
+            t = np.where(ok, t, 0.5 * t)
+        lam, val, w, Z = cand, v2, w2, Z2
+        if np.max(np.abs(t[:, None] * step)) < 1e-10:
+            break
+    return lam
+
+
+def emep(a1, b1, a2, b2, mu, dof: float | None = None, orders=(1, 2)):
+    """EMEP spreading D(μ) [1/rad] (module doc, 4) on a uniform grid mu [rad] over one turn.
+
+    ``dof``: the equivalent degrees of freedom of the coefficient estimates (a Welch bin's ν) — the
+    moments are then met within their sampling errors and the order N ∈ ``orders`` chosen by AIC; None:
+    exact moments, N = max(orders). Returns D of shape (n, len(mu)).
+    """
+    a1, b1, a2, b2 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (a1, b1, a2, b2))
+    mu = np.asarray(mu, dtype=float)
+    m_all = np.stack([a1, b1, a2, b2], axis=1)
+    F_all = np.stack([np.cos(mu), np.sin(mu), np.cos(2 * mu), np.sin(2 * mu)])
+    r = np.stack([np.hypot(a1, b1)] * 2 + [np.hypot(a2, b2)] * 2, axis=1)
+    sig2 = np.maximum(1.0 - r ** 2, 1e-4) / float(dof) if dof is not None else None
+    best_D = None
+    best_aic = None
+    dmu = TWO_PI / mu.size
+    for N in (sorted(orders) if dof is not None else [max(orders)]):
+        k = 2 * N
+        lam = _emep_fit(m_all[:, :k], np.full((m_all.shape[0], k), EMEP_EPS), F_all[:k], mu)
+        z = lam @ F_all[:k]
+        D = np.exp(z - z.max(axis=1, keepdims=True))
+        D = D / (D.sum(axis=1, keepdims=True) * dmu)
+        if dof is None:
+            return D
+        got = D @ F_all.T * dmu
+        aic = np.sum((got - m_all) ** 2 / np.maximum(sig2, 1e-12), axis=1) + 2.0 * k
+        if best_D is None:
+            best_D, best_aic = D, aic
+        else:
+            better = aic < best_aic
+            best_D = np.where(better[:, None], D, best_D)
+            best_aic = np.where(better, aic, best_aic)
+    return best_D
+
+
+METHODS = {"MLM": mlm, "IMLM": imlm, "MEM": mem, "EMEP": emep}
+
+
+def buoy_reports(record, instrument: str) -> tuple[np.ndarray, list[FourierCoefficients]]:
+    """(report times [s], one :class:`FourierCoefficients` per report) of a wave buoy's transmitted spectra
+    in a trial record (channels S, a1, b1, a2, b2 over the frequencies of its metadata, ``omega_rad_s``)."""
+    meta = record.meta(instrument)
+    if meta.get("kind") != "wave_buoy" or meta.get("output") != "spectra":
+        raise InputError(str(getattr(record, "path", "record")), f"{instrument}",
+                         "not a wave buoy's spectra (kind wave_buoy with output = 'spectra')")
+    omega = np.asarray(meta["omega_rad_s"], dtype=float)
+    t, S = record.channel(instrument, "S")
+    coef = {c: record.channel(instrument, c)[1] for c in ("a1", "b1", "a2", "b2")}
+    dof = float(meta.get("welch_dof", math.nan))
+    out = [FourierCoefficients(omega, np.asarray(S[i]), *(np.asarray(coef[c][i]) for c in ("a1", "b1", "a2", "b2")),
+                               dof) for i in range(np.size(t))]
+    return np.asarray(t), out
+
+
+def observed_sea(reports: list[FourierCoefficients], record_s: float) -> list[dict]:
+    """One observed wave system (module doc, 5) from the buoy reports of a window (each of ``record_s`` [s])."""
+    if not reports:
+        return []
+    w = reports[0].omega
+    S = np.mean([r.S for r in reports], axis=0)
+    m0 = float(np.trapezoid(S, w))
+    if not m0 > 0.0:
+        return []
+    A1 = float(np.mean([np.trapezoid(r.S * np.nan_to_num(r.a1), w) for r in reports])) / m0
+    B1 = float(np.mean([np.trapezoid(r.S * np.nan_to_num(r.b1), w) for r in reports])) / m0
+    k = int(np.argmax(S))
+    wp = float(w[k])
+    if 0 < k < w.size - 1:
+        d = S[k - 1] - 2.0 * S[k] + S[k + 1]
+        if d < 0.0:
+            wp += 0.5 * (S[k - 1] - S[k + 1]) / d * float(w[1] - w[0])
+    hs = 4.0 * math.sqrt(m0)
+    s_pm = 0.3125 * hs * hs / wp * math.exp(-1.25)  # Bretschneider / PM at its peak
+    ratio = float(np.max(S)) / s_pm
+    gamma = None
+    if ratio > 1.0:
+        lo, hi = 1.0, 10.0  # γ C(γ) rises monotonically on [1, 10]
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if mid * (1.0 - 0.287 * math.log(mid)) < ratio else (lo, mid)
+        gamma = 0.5 * (lo + hi)
+    nu0 = len(reports) * record_s * m0 * m0 / (math.pi * float(np.trapezoid(S * S, w)))
+    return [{"hs_m": hs, "tp_s": float(TWO_PI / wp), "gamma": gamma, "from_rad": (math.atan2(B1, A1) + math.pi) % TWO_PI,
+             "hs_rel_std": 0.5 * math.sqrt(2.0 / nu0), "tp_rel_std": float((w[1] - w[0]) / wp),
+             "from_std_rad": math.sqrt(2.0 * (1.0 - min(1.0, math.hypot(A1, B1)))) / math.sqrt(0.5 * nu0)}]
+
+
+def directional_estimate(fc: FourierCoefficients, method: str, mu=None, omega_lo: float = 0.0,
+                         omega_hi: float = math.inf, min_fraction: float = 0.0):
+    """(ω, S, D (n_ω, n_μ), μ, bulk mean direction [rad], bulk σ₁ [rad]) of one report by ``method``
+    ("MLM", "IMLM", "MEM", "EMEP"; "fourier": the coefficients' own bulk values, D = MEM's) over the band,
+    leaving out frequencies whose S is below ``min_fraction`` of the peak (noise-dominated tails)."""
+    if method != "fourier" and method not in METHODS:
+        raise InputError("reduction", "method", f"{method!r}: allowed fourier, {', '.join(METHODS)}")
+    mu = np.linspace(0.0, TWO_PI, 360, endpoint=False) if mu is None else np.asarray(mu, dtype=float)
+    m = (fc.omega >= omega_lo) & (fc.omega <= omega_hi) & np.isfinite(fc.a1) & np.isfinite(fc.a2)
+    m &= fc.S >= min_fraction * float(np.max(fc.S[m])) if np.any(m) else m
+    w, S = fc.omega[m], fc.S[m]
+    args = (fc.a1[m], fc.b1[m], fc.a2[m], fc.b2[m], mu)
+    if method == "fourier":
+        D = mem(*args)
+        m0 = np.trapezoid(S, w)
+        A1 = np.trapezoid(S * fc.a1[m], w) / m0
+        B1 = np.trapezoid(S * fc.b1[m], w) / m0
+        return w, S, D, mu, math.atan2(B1, A1) % TWO_PI, math.sqrt(2.0 * (1.0 - min(1.0, math.hypot(A1, B1))))
+    D = emep(*args, dof=fc.dof if math.isfinite(fc.dof) else None) if method == "EMEP" else METHODS[method](*args)
+    md, sg = bulk_from_directional(w, S, D, mu)
+    return w, S, D, mu, md, sg
 
 
 def spreading_moments(D, mu) -> tuple[np.ndarray, np.ndarray]:

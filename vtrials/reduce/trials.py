@@ -80,6 +80,9 @@ def run_statistics(rec: Record, run: dict) -> dict:
         st = {}
         for ch in rec.channels(name):
             t, x = rec.channel(name, ch)
+            if np.ndim(x) > 1:  # a spectrum per sample (wave buoy, wave radar): no run statistics of it
+                st[ch] = None
+                continue
             try:
                 st[ch] = RS.channel_stats(t, x, t0, t1, angular=_angular(kind, ch)).to_dict()
             except ValueError:  # fewer than two samples in the window (e.g. a slow display)

@@ -303,6 +303,23 @@ def write_agenda_outputs(res: AgendaResult, out_dir: str | Path, plot: bool = Tr
         return _write_agenda_outputs(res, out, plot)
 
 
+def _score_sea_sensors(res: AgendaResult, paths: dict) -> dict:
+    """Wave buoys and wave radars of each trial's record against the true sea (:mod:`vtrials.score.waves`);
+    {} when no instrument senses the sea (every shipped scenario: their results are unchanged)."""
+    kinds = {d.kind for d in res.crew.iset.devices.values()} if hasattr(res.crew, "iset") else set()
+    if not kinds & {"wave_buoy", "wave_radar"}:
+        return {}
+    from vtrials.scenario import wave_field
+    from vtrials.score.waves import score_wave_record
+    field = wave_field(res.scenario)
+    out = {}
+    for name, path in paths.items():
+        sc = score_wave_record(open_record(path), field)
+        if sc:
+            out[name] = sc
+    return out
+
+
 def _write_agenda_outputs(res: AgendaResult, out: Path, plot: bool) -> dict:
     from vtrials.reduce.trials import reduce_record
     from vtrials.report.trial_report import write_report
@@ -317,6 +334,7 @@ def _write_agenda_outputs(res: AgendaResult, out: Path, plot: bool) -> dict:
         reduced = reduce_record(open_record(paths[name]))  # the reduction sees the record file only
         scored = score_trial(trial.head.kind, reduced, res, name)
         trials.append({"name": name, "kind": trial.head.kind, "record": f"records/{name}.nc", **scored})
+    waves = _score_sea_sensors(res, paths)
     t2 = time.perf_counter()
     res.timings.update({"write_s": t1 - t0, "reduce_score_s": t2 - t1})
     crew = res.crew
@@ -331,6 +349,8 @@ def _write_agenda_outputs(res: AgendaResult, out: Path, plot: bool) -> dict:
                                        for t in s.agenda.trials},
                       "total_time_s": crew.t},
            "trials": trials}
+    if waves:  # only when the scenario lists sea sensors (wave buoys, wave radar)
+        doc["wave_instruments"] = waves
     doc = json_clean(doc)
     if plot:
         write_report(doc, res, out)
