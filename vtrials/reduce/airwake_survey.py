@@ -61,15 +61,17 @@ def _interp(t_out, t, x, angular=False):
 def _stats3(t, x, inst: dict | None = None) -> list:
     """Mean per component with its autocorrelation-corrected standard error; with ``inst`` (the
     anemometer's stated accuracy: zero offset σ_b, scale σ_s, head alignment σ_a [rad]) the instrument's
-    own uncertainty of a mean is added in quadrature, u² = σ_b² + (σ_s x̄_k)² + (σ_a |x̄|)² (the head's
-    misalignment turns the mean vector by about σ_a), degrees of freedom by Welch–Satterthwaite (the
-    stated accuracies as exact: infinite dof)."""
+    own uncertainty of a mean is added in quadrature, u² = σ_b² + (σ_s x̄_k)² + σ_a² (|x̄|² − x̄_k²) (the
+    head's misalignment, three small angles of σ_a, turns the mean vector: δ × x̄ moves component k by
+    the other two components), degrees of freedom by Welch–Satterthwaite (the stated accuracies as
+    exact: infinite dof)."""
     out = []
-    mag = float(np.linalg.norm(np.mean(x, axis=0)))
+    xm = np.mean(x, axis=0)
+    mag2 = float(xm @ xm)
     for k in range(3):
         e = channel_stats(t, x[:, k]).estimate()
         if inst:
-            ui2 = inst["bias"] ** 2 + (inst["scale"] * e.value) ** 2 + (inst["align"] * mag) ** 2
+            ui2 = inst["bias"] ** 2 + (inst["scale"] * e.value) ** 2 + inst["align"] ** 2 * (mag2 - float(xm[k]) ** 2)
             std = math.sqrt(e.std ** 2 + ui2)
             dof = e.dof * (std / e.std) ** 4 if e.std > 0 else None
             e = Estimate(e.value, std, dof)
