@@ -411,7 +411,9 @@ def _aw_markdown(tr: dict) -> list[str]:
          f"Motion-induced velocity left after AWSM (max over recordings): {_pc(s['max_residual_fraction_awsm'])} "
          f"(the seed's order, body-axis mean removed then rotated: "
          f"{_pc(s['max_residual_fraction_awsm_seed_order'])}); acceptance < 10 %: {s['residual_accepted']}. "
-         f"Mean airwake unchanged by the correction within its 95 % interval: {s['mean_unchanged_all']}. "
+         f"Mean airwake unchanged by the correction within its 95 % interval: {s['mean_unchanged_all']} "
+         f"(largest change {s['max_abs_mean_change']:.3f} m/s; indistinguishable from zero by its own interval in "
+         f"{_pc(s['mean_change_indistinguishable_from_zero'])} of the components). "
          f"Coverage of the 95 % intervals (mean components, ratios): {_pc(s['coverage'])}.", "",
          "| run | position | wind ordered | ratio K (95 %) | true K | motion-induced RMS [m/s] | left by AWSM | "
          "mean change u, v, w [m/s] |", "|---|---|---|---|---|---|---|---|"]

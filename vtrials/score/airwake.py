@@ -78,6 +78,7 @@ def score_airwake_survey(reduced: dict, res, name: str) -> dict:
         ref_clk = iset.clocks.get(reduced["reference"])
     runs = []
     fr_main, fr_seed, fr_first, mean_ok, cover = [], [], [], [], []
+    max_change, zero_ok = 0.0, []
     for r in reduced["runs"]:
         s = r.pop("_series", None)
         d = {"run": r["run"], "position": r["position"]}
@@ -114,9 +115,14 @@ def score_airwake_survey(reduced: dict, res, name: str) -> dict:
         for k in range(3):
             change = r["mean_change"][k]["value"]
             hw = 0.5 * (r["mean_awsm"][k]["hi95"] - r["mean_awsm"][k]["lo95"])
-            ch.append({"change": change, "half_width95": hw, "within": abs(change) <= hw})
+            own = r["mean_change"][k]
+            ch.append({"change": change, "half_width95": hw, "within": abs(change) <= hw,
+                       # stricter: is the change itself distinguishable from zero (its own 95 % interval)?
+                       "zero_in_own_interval": bool(own["lo95"] <= 0.0 <= own["hi95"])})
+            max_change = max(max_change, abs(change))
         d["mean_change"] = ch
         mean_ok.append(all(c["within"] for c in ch))
+        zero_ok += [c["zero_in_own_interval"] for c in ch]
         if ref_tr is not None and "airwake_ratio" in r:
             a_ref, _ = true_airwake(ref_tr, _true_time(ref_clk, np.asarray(s["t"])))
             k_true = float(np.mean(np.hypot(a_v[:, 0], a_v[:, 1])) / np.mean(np.hypot(a_ref[:, 0], a_ref[:, 1])))
@@ -130,6 +136,8 @@ def score_airwake_survey(reduced: dict, res, name: str) -> dict:
                "residual_accepted": bool(fr_main) and max(fr_main) < ACCEPT_RESIDUAL,
                "mean_unchanged_all": bool(mean_ok) and all(mean_ok),
                "mean_unchanged_fraction": (sum(mean_ok) / len(mean_ok)) if mean_ok else None,
+               "max_abs_mean_change": max_change,
+               "mean_change_indistinguishable_from_zero": (sum(zero_ok) / len(zero_ok)) if zero_ok else None,
                "coverage": (sum(bool(c) for c in cover) / len(cover)) if cover else None}
     truth = {"runs": [{"run": r["run"], "position": r["position"]} for r in reduced["runs"]]}
     return {"reduced": reduced, "truth": truth, "error": {"summary": summary, "runs": runs}}
