@@ -627,4 +627,7 @@ def reduce_record(rec: Record) -> dict:
     if kind == "maneuvering":
         from vtrials.reduce.maneuvering import reduce_maneuvering
         return reduce_maneuvering(rec)
+    if kind == "airwake_survey":
+        from vtrials.reduce.airwake_survey import reduce_airwake_survey
+        return reduce_airwake_survey(rec)
     raise ValueError(f"{rec.path}: no reduction for trial kind {kind!r}")

@@ -541,6 +541,9 @@ class Crew:
 
     # ------------------------------------------------------------------ runs
     def execute(self, run: Run, attempt: int) -> Attempt:
+        if run.kind == "airwake":
+            from vtrials.trials import airwake_survey
+            return airwake_survey.execute(self, run, attempt)
         if run.kind != "speed":
             return self.execute_maneuver(run, attempt)
         att = Attempt(run, attempt, math.degrees(run.heading) % 360.0, [], [], list(run.modes), self.t)
