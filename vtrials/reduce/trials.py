@@ -624,4 +624,7 @@ def reduce_record(rec: Record) -> dict:
     if kind == "maneuvering":
         from vtrials.reduce.maneuvering import reduce_maneuvering
         return reduce_maneuvering(rec)
+    if kind == "seakeeping":
+        from vtrials.reduce.seakeeping import reduce_seakeeping
+        return reduce_seakeeping(rec)
     raise ValueError(f"{rec.path}: no reduction for trial kind {kind!r}")

@@ -388,4 +388,7 @@ def score_trial(kind: str, reduced: dict, res, name: str) -> dict:
         return score_log_calibration(reduced, res, name)
     if kind == "maneuvering":
         return score_maneuvering(reduced, res, name)
+    if kind == "seakeeping":
+        from vtrials.score.seakeeping import score_seakeeping
+        return score_seakeeping(reduced, res, name)
     raise ValueError(f"no scoring for trial kind {kind!r}")
