@@ -285,7 +285,8 @@ def instrument_set(scn: Scenario, stream: tuple = (), scenario_file: str | None 
     """The ship's instruments with the scenario's additions, reading the scenario's sea: anemometers
     scale the truth's wind speed (at the wind's reference height) to their own height with the
     simulated wind's profile (its exponent and reference height, as :func:`environment_block` packs
-    them), not with a profile of their own."""
+    them), not with a profile of their own. Instruments that sense the sea itself (wave buoys, wave
+    radar, bow relative-motion meter) get the scenario's seaway realization (:func:`wave_field`)."""
     from vtrials.instruments.suite import InstrumentSet
     f = str(scn.path) if scenario_file is None else scenario_file  # the name messages give the file
     iset = InstrumentSet(scn.vessel, scn.head.seed, scn.site, scn.instrument_items, f, stream=stream,
@@ -294,6 +295,8 @@ def instrument_set(scn: Scenario, stream: tuple = (), scenario_file: str | None 
         field = wave_field(scn)  # wave probes see the scenario's sea surface
         if field is not None:
             iset.set_seaway(field.components)
+    if iset.needs_sea:  # wave buoys, wave radar, relative-motion meter read the seaway itself (opt-in)
+        iset.attach_sea(wave_field(scn))
     return iset
 
 

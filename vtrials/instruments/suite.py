@@ -39,8 +39,11 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.schema import did_you_mean, check_name, check_value, load_toml, num, read_table, table, text, unknown_key, Spec
-from vtrials.instruments.devices import KINDS, RudderAngle, ShaftDevice, SpecError
+from vtrials.instruments.devices import KINDS as SHIP_KINDS, RudderAngle, ShaftDevice, SpecError
 from vtrials.instruments.parts import ClockOffset
+from vtrials.instruments.wave_sensors import WAVE_KINDS
+
+KINDS = {**SHIP_KINDS, **WAVE_KINDS}  # ship instruments, then the sea's (wave buoys, wave radar, relative motion)
 
 CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
 SEED_KEY = 4  # spawn-key namespace of instrument streams
@@ -274,9 +277,9 @@ class InstrumentSet:
                 k = names.index(e.rudder)
                 rd = v.rudders[k]
                 return cls(e.name, spec, f"rudder {e.rudder}", np.array([rd.x, rd.y, rd.z]), self.team, k)
-            if e.site is None:
+            if e.site is None and getattr(cls, "hull_site_required", True):
                 raise InputError(f, f"{where}.site", f"a {kind} instrument needs a site")
-            return cls(e.name, spec, e.site, site, self.team)
+            return cls(e.name, spec, e.site or "sea", site, self.team)
         except SpecError as exc:
             raise InputError(f, f"{where}.{exc.field}", exc.problem) from None
 
@@ -365,6 +368,17 @@ class InstrumentSet:
         t = np.concatenate([p[0] for p in sel])
         keep = t >= t0
         return t[keep], {c: np.concatenate([p[1][c] for p in sel])[keep] for c in dev.channels}
+
+    @property
+    def needs_sea(self) -> bool:
+        """Whether any instrument senses the seaway itself (wave buoys, wave radar, relative motion)."""
+        return any(getattr(d, "needs_sea", False) for d in self.devices.values())
+
+    def attach_sea(self, field) -> None:
+        """Give the sea-sensing instruments the scenario's seaway (a WaveField, or None for a calm sea)."""
+        for d in self.devices.values():
+            if getattr(d, "needs_sea", False):
+                d.attach_sea(field)
 
     def of_kind(self, kind: str) -> list[str]:
         """Names of the instruments of one kind (e.g. "shaft_torque"), in name order."""

@@ -51,7 +51,9 @@ def _attr(v):
 
 def write_groups(path: str | Path, groups: dict, attrs: dict) -> None:
     """Write ``groups`` = {name: {"time": array, "variables": {var: (array, units, long_name)},
-    "attrs": {...}}} as netCDF4 groups with a ``time`` dimension each; ``attrs`` are global."""
+    "attrs": {...}}} as netCDF4 groups with a ``time`` dimension each; ``attrs`` are global. A variable
+    with more than one dimension (e.g. a wave spectrum per sample) gets dimensions ``<var>_axis1``, …
+    after ``time``."""
     with atomic_path(path) as tmp:
         with h5netcdf.File(tmp, "w", track_order=True) as f:
             for k, v in attrs.items():
@@ -70,7 +72,11 @@ def write_groups(path: str | Path, groups: dict, attrs: dict) -> None:
                     grp.attrs[k] = _attr(v)
                 for vname, (arr, units, long_name) in g["variables"].items():
                     arr = np.asarray(arr, dtype=np.float64)
-                    var = grp.create_variable(vname, ("time",), np.float64, compression="gzip",
+                    dims = ("time",)
+                    for k, n in enumerate(arr.shape[1:]):  # a spectrum per sample: extra dimensions of its own
+                        dims += (f"{vname}_axis{k + 1}",)
+                        grp.dimensions[dims[-1]] = n
+                    var = grp.create_variable(vname, dims, np.float64, compression="gzip",
                                               compression_opts=4, shuffle=True)
                     var[:] = arr
                     var.attrs["units"] = units
