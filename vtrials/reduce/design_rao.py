@@ -59,6 +59,14 @@ class DesignRAO:
         self.C = data["restoring"][sub]
         self.B44 = float(attrs["roll_damping_linear"])
         self.X = (data["excitation_force_re"] + 1j * data["excitation_force_im"])[:, :, list(FREE)]
+        # port–starboard symmetry of the hull: roll is uncoupled from heave and pitch (the BEM's and the
+        # mesh hydrostatics' numerical roll couplings, ~1e-4 of the diagonals, are set to zero)
+        for a in (self.A, self.B):
+            a[:, 1, [0, 2]] = 0.0
+            a[:, [0, 2], 1] = 0.0
+        for a in (self.A_inf, self.M, self.C):
+            a[1, [0, 2]] = 0.0
+            a[[0, 2], 1] = 0.0
         self.g = float(attrs["g"])
         self.x_from_midship = float(attrs["reference_x_from_midship"])
         self.design = json.loads(attrs.get("design_toml", "{}"))
