@@ -43,6 +43,9 @@ LEGS = ("head", "bow_starboard", "bow_port", "following")
 # (H_s [m], seed): one sweep over 1.5-5 m, then a second seed at every metre
 CASES = [(hs, 13000 + k) for k, hs in enumerate((1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0))] + \
         [(hs, 13100 + k) for k, hs in enumerate((2.0, 3.0, 4.0, 5.0, 1.5, 2.5, 3.5, 4.5))]
+# the team's leg acceptance (records only): the course held within this standard deviation of the gyro heading
+# over the leg (a leg that wanders has no single relative wave direction; fusion assumes one)
+MAX_HEADING_STD_DEG = 10.0
 COMBOS = (("heave",), ("pitch",), ("roll",), ("acc",), ("heave", "pitch"), ("heave", "roll"), ("pitch", "roll"),
           ("heave", "acc"), ("pitch", "acc"), ("heave", "pitch", "roll"), ("heave", "pitch", "acc"))
 
@@ -51,12 +54,16 @@ def tp_of(hs: float) -> float:
     return 6.45 + 1.2 * hs
 
 
-def scenario_text(hs: float, seed: int) -> str:
-    legs = "".join(f'[[agenda.trial.leg]]\nheading = "{h}"\norder = "ahead_1_3"\nleg_s = {LEG_S}\n\n' for h in LEGS)
+RADAR_SITE = {"patrol51": "transponder_mast", "kvlcc2": "bridge"}
+
+
+def scenario_text(hs: float, seed: int, ship: str = "patrol51", order: str = "ahead_1_3", legs=LEGS,
+                  leg_s: float = LEG_S) -> str:
+    legs = "".join(f'[[agenda.trial.leg]]\nheading = "{h}"\norder = "{order}"\nleg_s = {leg_s}\n\n' for h in legs)
     return f"""# wave-fusion campaign case (benchmarks/campaign_wavefusion.py)
 [scenario]
-title = "patrol51 seakeeping star, H_s {hs} m, radar + motions"
-ship = "patrol51"
+title = "{ship} seakeeping star, H_s {hs} m, radar + motions"
+ship = "{ship}"
 seed = {seed}
 timestep_s = 0.05
 record_every = 1
@@ -100,11 +107,11 @@ kind = "seakeeping"
 {legs}[[instrument]]
 name = "radar"
 spec = "wave_radar_recalibrated"
-site = "transponder_mast"
+site = "{RADAR_SITE[ship]}"
 """
 
 
-def reduce_case(out: Path, scn, design) -> list[dict]:
+def reduce_case(out: Path, scn, design, legs=LEGS) -> list[dict]:
     rec = open_record(out / "records" / "seakeeping.nc")
     tr = read_groups(out / "truth.nc")["groups"]["agenda"]["variables"]
     comp = wave_field(scn).components
@@ -112,19 +119,29 @@ def reduce_case(out: Path, scn, design) -> list[dict]:
     for run, t0, t1 in run_windows(rec):
         st = sea_truth(comp, window_heading(tr["time"], tr["heading"], t0, t1))
         f = fuse_run(rec, t0, t1, design, combos=COMBOS)
-        row = {"seed": scn.head.seed, "run": run, "leg": LEGS[run - 1] if run <= len(LEGS) else str(run),
+        k = (tr["time"] >= t0) & (tr["time"] <= t1)
+        row = {"seed": scn.head.seed, "run": run, "leg": legs[run - 1] if run <= len(legs) else str(run),
                "hs_true": st["hs"], "from_rel_true_deg": st["from_rel_deg"], "U_log": f.U,
                "hs_radar": f.hs_radar, "radar_ratio": f.hs_radar / st["hs"], "n_spectra": f.n_spectra,
                "measured": f.measured, "predicted": f.predicted,
                "fused_ratio": {k: v.hs / st["hs"] for k, v in f.fused.items()},
-               "r": {k: v.r for k, v in f.fused.items()}}
+               "r": {c: v.r for c, v in f.fused.items()},
+               "heading_std_deg": math.degrees(f.heading_std), "accepted": math.degrees(f.heading_std) <= MAX_HEADING_STD_DEG,
+               "roll_std_true_deg": math.degrees(float(np.std(tr["roll"][k])))}
         rows.append(row)
-        print(json.dumps({k: row[k] for k in ("seed", "run", "leg", "hs_true", "radar_ratio")}
+        print(json.dumps({c: row[c] for c in ("seed", "run", "leg", "hs_true", "radar_ratio", "heading_std_deg")}
                          | {"heave+pitch": round(row["fused_ratio"]["heave+pitch"], 3)}), flush=True)
     return rows
 
 
 def summary(rows) -> dict:
+    acc = [r for r in rows if r.get("accepted", True)]
+    out = {"all_legs": _summary(rows), "accepted_legs": _summary(acc) if len(acc) > 1 else None,
+           "n_rejected": len(rows) - len(acc)}
+    return out
+
+
+def _summary(rows) -> dict:
     rad = np.array([r["radar_ratio"] for r in rows])
     hs = np.array([r["hs_true"] for r in rows])
     out = {"n_runs": len(rows), "radar_ratio_mean": float(np.mean(rad)), "radar_ratio_std": float(np.std(rad, ddof=1)),
@@ -142,20 +159,27 @@ def summary(rows) -> dict:
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", type=int, default=len(CASES))
+    ap.add_argument("--ship", default="patrol51")
+    ap.add_argument("--order", default="ahead_1_3")
+    ap.add_argument("--legs", default=",".join(LEGS))
+    ap.add_argument("--leg-s", type=float, default=LEG_S)
+    ap.add_argument("--out", default=str(OUT))
     a = ap.parse_args(argv)
-    design = load_design_rao("patrol51")
+    legs = tuple(a.legs.split(","))
+    out_json = Path(a.out)
+    design = load_design_rao(a.ship)
     rows, failed = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for hs, seed in CASES[:a.cases]:
             p = Path(tmp) / f"case_{seed}.toml"
-            p.write_text(scenario_text(hs, seed))
+            p.write_text(scenario_text(hs, seed, a.ship, a.order, legs, a.leg_s))
             t = time.perf_counter()
             try:
                 scn = load_scenario(p)
                 res = simulate_agenda(scn)
                 out = Path(tmp) / f"out_{seed}"
                 write_agenda_outputs(res, out, plot=False)
-                new = reduce_case(out, scn, design)
+                new = reduce_case(out, scn, design, legs)
             except Exception as exc:  # a case the ship or the crew could not complete is reported, not hidden
                 failed.append({"hs": hs, "seed": seed, "error": f"{type(exc).__name__}: {exc}"[:300]})
                 print(f"case H_s {hs} seed {seed} FAILED: {exc}", flush=True)
@@ -165,10 +189,11 @@ def main(argv=None) -> dict:
                 r["tp"] = tp_of(hs)
             rows += new
             print(f"case H_s {hs} seed {seed}: {time.perf_counter() - t:.0f} s", flush=True)
-            doc = {"legs": LEGS, "leg_s": LEG_S, "order": "ahead_1_3", "radar": "wave_radar_recalibrated",
-                   "design_file": "models/patrol51/design/patrol51_design_rao.nc", "rows": rows, "failed": failed,
+            doc = {"ship": a.ship, "legs": legs, "leg_s": a.leg_s, "order": a.order, "radar": "wave_radar_recalibrated",
+                   "max_heading_std_deg": MAX_HEADING_STD_DEG,
+                   "design_file": f"models/{a.ship}/design/{a.ship}_design_rao.nc", "rows": rows, "failed": failed,
                    "summary": summary(rows) if len(rows) > 1 else None}
-            OUT.write_text(json.dumps(doc, indent=1))
+            out_json.write_text(json.dumps(doc, indent=1))
     s = summary(rows)
     print(json.dumps(s, indent=1))
     return s

@@ -30,7 +30,9 @@ from vtrials.units import G
 class RunMotions:
     """Motion series of one run on a uniform grid: time [s], heave UP at the IMU [m], roll, pitch [rad],
     vertical acceleration (earth down, at the IMU) [m/s²]; fs [Hz]; mean speed through the water U [m/s];
-    mean heading [rad] (towards, from north); IMU site (x, y, z) [m] from O."""
+    mean heading [rad] (towards, from north); IMU site (x, y, z) [m] from O; heading_std [rad]: standard
+    deviation of the (unwrapped) gyro heading over the window — a leg whose course was not held has no
+    single relative wave direction (the wave reductions assume one)."""
 
     t: np.ndarray
     heave: np.ndarray
@@ -41,6 +43,7 @@ class RunMotions:
     U: float
     heading: float
     site: tuple
+    heading_std: float = 0.0
 
     def series(self, names) -> np.ndarray:
         """(len(names), n) of 'heave', 'roll', 'pitch', 'acc'."""
@@ -93,10 +96,11 @@ def run_motions(record, t0: float, t1: float, fs_out: float = 2.0, omega_c: floa
     th, hdg = record.channel(compass, "heading")
     kh = _window(th, t0, t1, compass) & np.isfinite(hdg)
     heading = math.atan2(float(np.mean(np.sin(hdg[kh]))), float(np.mean(np.cos(hdg[kh])))) % (2.0 * math.pi)
+    heading_std = float(np.std(np.unwrap(hdg[kh])))
     site = tuple(float(v) for v in record.meta(imu).get("surveyed_position_m", (0.0, 0.0, 0.0)))
     acc_d = dec(acc)
     return RunMotions(ti[::q][:acc_d.size], dec(heave), dec(roll_i), dec(pitch_i), acc_d - np.mean(acc_d),
-                      fs / q, float(np.mean(spd[kl])), heading, site)
+                      fs / q, float(np.mean(spd[kl])), heading, site, heading_std)
 
 
 def run_windows(record, min_s: float = 120.0) -> list[tuple[int, float, float]]:

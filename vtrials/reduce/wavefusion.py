@@ -89,6 +89,7 @@ class RunFusion:
     fused: dict          # {"heave+pitch": Fusion, ...}
     U: float
     heading: float
+    heading_std: float = 0.0
 
 
 def radar_window(record, t0: float, t1: float, radar: str = "radar"):
@@ -134,4 +135,4 @@ def fuse_run(record, t0: float, t1: float, design, combos=(("heave", "pitch"),),
         pred[c] = predicted_rms(w, mu_rel, S, h)
         meas[c] = float(np.std(ser[i]))
     fused = {"+".join(combo): fuse(hs_r, S, [meas[c] for c in combo], [pred[c] for c in combo]) for combo in combos}
-    return RunFusion(hs_r, n, meas, pred, fused, mot.U, mot.heading)
+    return RunFusion(hs_r, n, meas, pred, fused, mot.U, mot.heading, mot.heading_std)
