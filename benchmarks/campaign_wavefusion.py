@@ -31,6 +31,7 @@ import numpy as np
 from vtrials.records.netcdf import open_record, read_groups
 from vtrials.reduce.design_rao import load_design_rao
 from vtrials.reduce.seamotion import run_windows
+from vtrials.reduce.shipbuoy import ship_buoy_from_record
 from vtrials.reduce.wavefusion import fuse_run
 from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 from vtrials.scenario import load_scenario, wave_field
@@ -128,6 +129,15 @@ def reduce_case(out: Path, scn, design, legs=LEGS) -> list[dict]:
                "r": {c: v.r for c, v in f.fused.items()},
                "heading_std_deg": math.degrees(f.heading_std), "accepted": math.degrees(f.heading_std) <= MAX_HEADING_STD_DEG,
                "roll_std_true_deg": math.degrees(float(np.std(tr["roll"][k])))}
+        try:   # the ship as a wave buoy on the same leg (the design RAOs, no radar)
+            rb = ship_buoy_from_record(rec, t0, t1, design)
+            d = math.degrees(math.remainder(math.radians(rb.from_relative_deg - st["from_rel_deg"]), 2 * math.pi))
+            row["buoy"] = {"hs_err": rb.fit.hs / st["hs"] - 1.0, "from_rel_deg": rb.from_relative_deg, "dir_err_deg": d,
+                           "side_right": bool(abs(st["from_rel_deg"]) < 10.0 or abs(st["from_rel_deg"]) > 170.0
+                                              or np.sign(rb.from_relative_deg) == np.sign(st["from_rel_deg"])),
+                           "tp": rb.fit.tp, "s": rb.fit.s, "gamma": rb.fit.gamma}
+        except Exception as exc:  # reported, not hidden
+            row["buoy"] = {"error": f"{type(exc).__name__}: {exc}"[:200]}
         rows.append(row)
         print(json.dumps({c: row[c] for c in ("seed", "run", "leg", "hs_true", "radar_ratio", "heading_std_deg")}
                          | {"heave+pitch": round(row["fused_ratio"]["heave+pitch"], 3)}), flush=True)
@@ -153,6 +163,14 @@ def _summary(rows) -> dict:
         out["combos"][c] = {"mean": float(np.mean(f)), "std": sd, "scatter_reduction": out["radar_ratio_std"] / sd,
                             "within_15pct_above_2.5m": int(np.sum((np.abs(f - 1) <= 0.15) & (hs > 2.5))),
                             "within_15pct_all": int(np.sum(np.abs(f - 1) <= 0.15))}
+    b = [r["buoy"] for r in rows if "hs_err" in r.get("buoy", {})]
+    if b:
+        he = np.array([x["hs_err"] for x in b])
+        de = np.array([abs(x["dir_err_deg"]) for x in b])
+        out["ship_buoy"] = {"n": len(b), "hs_within_15pct": int(np.sum(np.abs(he) <= 0.15)),
+                            "dir_within_15deg": int(np.sum(de <= 15.0)), "side_right": int(sum(x["side_right"] for x in b)),
+                            "hs_err_mean": float(np.mean(he)), "hs_abs_err_median": float(np.median(np.abs(he))),
+                            "dir_abs_err_median_deg": float(np.median(de))}
     return out
 
 

@@ -1,4 +1,4 @@
-"""How far the trials team's design-stage RAO model is from the simulator's truth (patrol51).
+"""How far the trials team's design-stage RAO model is from the simulator's truth (patrol51; --ship kvlcc2).
 
 Truth: :class:`vtrials.truth.motion_rao.TruthRAO` (the coupled six-DOF model the simulator integrates).
 Design: :class:`vtrials.reduce.design_rao.DesignRAO` (models/patrol51/design). Compared per speed and
@@ -6,8 +6,10 @@ heading: the RMS heave, roll and pitch at O in a long-crested JONSWAP sea (γ 3.
 6, 8 and 10 s (the truth's quadratic roll damping linearised at its own roll-rate std), and the peak
 |RAO| over 0.25-2.5 rad/s. Writes benchmarks/results/design_rao_vs_truth.json and prints a Markdown table.
 
-    PYTHONPATH=. python benchmarks/design_rao_vs_truth.py
+    PYTHONPATH=. python benchmarks/design_rao_vs_truth.py [--ship kvlcc2 --speeds 4,7 --tps 8,10,12]
 """
+
+import argparse
 
 from __future__ import annotations
 
@@ -29,16 +31,25 @@ HS = 2.0
 NAMES = ("heave", "roll", "pitch")
 
 
-def main() -> dict:
-    design = load_design_rao("patrol51")
-    w = np.linspace(0.25, 2.5, 600)
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--ship", default="patrol51")
+    ap.add_argument("--speeds", default=",".join(str(v) for v in SPEEDS))
+    ap.add_argument("--tps", default=",".join(str(v) for v in TPS))
+    a = ap.parse_args(argv)
+    ship = a.ship
+    speeds = [float(v) for v in a.speeds.split(",")]
+    tps = [float(v) for v in a.tps.split(",")]
+    out_path = OUT if ship == "patrol51" else OUT.with_name(f"design_rao_vs_truth_{ship}.json")
+    design = load_design_rao(ship)
+    w = np.linspace(0.25, 2.5, 600) if ship == "patrol51" else np.linspace(0.12, 1.4, 600)
     rows = []
-    for U in SPEEDS:
-        tr = TruthRAO("patrol51", U)
+    for U in speeds:
+        tr = TruthRAO(ship, U)
         for hd in HEADINGS_DEG:
             mu = math.radians(hd)
             D = design.rao(w, mu, tr.U)
-            for tp in TPS:
+            for tp in tps:
                 S = spectrum("jonswap", w, HS, peak_frequency("jonswap", 3.3, tp=tp), 3.3)
                 sp = tr.roll_rate_std(w, S, mu)
                 T = tr.rao(w, mu, sp)
@@ -54,9 +65,9 @@ def main() -> dict:
                     row[f"{n}_peak_design"] = pd
                 rows.append(row)
                 print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in row.items()}), flush=True)
-    out = {"ship": "patrol51", "design_file": str(design.path.relative_to(Path(__file__).resolve().parents[1])),
-           "hs": HS, "tps": TPS, "rows": rows}
-    OUT.write_text(json.dumps(out, indent=1))
+    out = {"ship": ship, "design_file": str(design.path.relative_to(Path(__file__).resolve().parents[1])),
+           "hs": HS, "tps": tps, "rows": rows}
+    out_path.write_text(json.dumps(out, indent=1))
     print("\n| U [m/s] | μ [deg] | T_p [s] | heave RMS | roll RMS | pitch RMS |")
     print("|---|---|---|---|---|---|")
     for r in rows:

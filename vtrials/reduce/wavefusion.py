@@ -14,6 +14,12 @@ mean of r_i over the chosen components (eq. 5), H_s = r H_s,radar (eq. 1) and S�
 The RAOs are an INPUT: the design-stage model the trials team has (seed 004 used the strip-theory code
 ShipMo7), never the simulator's truth. Angles μ are the wave propagation direction relative to the
 ship's heading (0 following, π head seas) on a uniform grid over one turn.
+
+From a trial record, :func:`fuse_run` does the whole thing for one run: the radar's mean directional
+spectrum over the run (turned into the ship's frame with the gyro heading), the design-stage RAOs
+(:mod:`vtrials.reduce.design_rao`) at the run's mean log speed, the measured RMS of heave (IMU, double
+integrated), pitch, roll and vertical acceleration (:mod:`vtrials.reduce.seamotion`). Measured on
+simulator records: benchmarks/campaign_wavefusion.py (results in benchmarks/results/).
 """
 
 from __future__ import annotations
