@@ -9,10 +9,9 @@ heading: the RMS heave, roll and pitch at O in a long-crested JONSWAP sea (γ 3.
     PYTHONPATH=. python benchmarks/design_rao_vs_truth.py [--ship kvlcc2 --speeds 4,7 --tps 8,10,12]
 """
 
-import argparse
-
 from __future__ import annotations
 
+import argparse
 import json
 import math
 from pathlib import Path
