@@ -122,3 +122,15 @@ def test_wave_fusion_on_a_record_removes_the_radar_calibration_error(leg):
     # r is the measured over predicted RMS, the same for any radar scale: fused H_s does not depend on it
     assert f.fused["heave+pitch"].r == pytest.approx(
         0.5 * sum(f.measured[c] / f.predicted[c] for c in ("heave", "pitch")), rel=1e-12)
+
+
+def test_bad_input_is_named(leg):
+    from vtrials.errors import InputError
+    rec, t0, t1, _ = leg
+    design = load_design_rao("patrol51")
+    with pytest.raises(InputError, match="no_radar"):
+        fuse_run(rec, t0, t1, design, radar="no_radar")
+    with pytest.raises(InputError, match="fewer than 64 samples"):
+        ship_buoy_from_record(rec, t0, t0 + 1.0, design)
+    with pytest.raises(InputError, match="allowed heave, roll, pitch, acc"):
+        fuse_run(rec, t0, t1, design, combos=(("sway",),))

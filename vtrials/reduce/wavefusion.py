@@ -125,6 +125,10 @@ def fuse_run(record, t0: float, t1: float, design, combos=(("heave", "pitch"),),
     'acc' (vertical acceleration at the IMU) fused together (r = mean of their ratios)."""
     from vtrials.reduce.seamotion import design_responses, run_motions
 
+    bad = sorted({c for combo in combos for c in combo} - set(COMPONENTS))
+    if bad or not combos or any(len(c) == 0 for c in combos):
+        raise InputError("record", "combos", f"{bad or list(combos)}: each combination is a non-empty tuple of "
+                         f"motion components; allowed heave, roll, pitch, acc")
     mot = run_motions(record, t0, t1, fs_out=fs, omega_c=omega_c)
     w, mu_to, S, hs_r, n = radar_window(record, t0, t1, radar)
     mu_rel = mu_to - mot.heading
