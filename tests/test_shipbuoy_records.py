@@ -4,11 +4,14 @@ DESIGN-STAGE RAOs (models/patrol51/design), scored against the true sea (vtrials
 One short seakeeping leg of patrol51 (7 min at 8 kn, waves from the port quarter, H_s 1.5 m, cos-2s s = 10)
 with the X-band wave radar at its TRIAL calibration (reads 1.51× the sea on average, seed 004):
 
-* ship as a wave buoy: H_s within 15 %, mean direction within 15°, port/starboard right (campaign of
-  16 runs in benchmarks/results/shipbuoy_sim.json: directions 16/16 within 13°, sides 16/16; H_s 9/16
-  within 15 %, bow seas under-read by 13–24 % from the design model's heave/roll errors);
+* ship as a wave buoy: H_s within 15 %, mean direction within 15°, port/starboard right (16 runs in
+  benchmarks/results/shipbuoy_sim.json: directions 16/16 within 13°, sides 16/16; H_s 9/16 within 15 %,
+  bow seas under-read by 13–24 % from the design model's heave/roll errors; 52 star legs at 9 m/s in
+  campaign_wavefusion.json: sides 52/52, directions 35/52 within 15°, H_s 33/52 within 15 %);
 * wave fusion (seed 004 eqs. 1–5) with heave + pitch takes out the radar's calibration error: fused H_s
-  within 15 % while the radar is more than 25 % off (campaign: benchmarks/results/campaign_wavefusion.json).
+  within 15 % while the radar is more than 25 % off (campaign of 52 25-min legs over H_s 1.5–5 m in
+  benchmarks/results/campaign_wavefusion.json: radar/true std 0.252 → 0.073 fused, 27/28 within ±15 %
+  above 2.5 m).
 """
 
 from __future__ import annotations
