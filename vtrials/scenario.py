@@ -266,6 +266,11 @@ def load_scenario(path: str | Path, doc: dict | None = None) -> Scenario:
     if has_agenda:
         from vtrials.trials.agenda import load_agenda
         agenda = load_agenda(table(doc["agenda"], f, "agenda"), vessel, f)
+        for k, trial in enumerate(agenda.trials):
+            if trial.head.kind == "seakeeping" and not waves.hs_m > 0.0:
+                raise InputError(f, f"agenda.trial[{k}].kind", "a seakeeping trial needs a wind sea "
+                                                               "([environment.waves] hs_m > 0): its legs are "
+                                                               "laid relative to the mean wave direction")
     instruments = table_list(doc.get("instrument", []), f, "instrument")
     scn = Scenario(p, head, init, env, current, wind, maneuvers, vessel, site, instruments, agenda, waves=waves,
                    wave_loads=wave_loads)
@@ -286,6 +291,10 @@ def instrument_set(scn: Scenario, stream: tuple = (), scenario_file: str | None 
     f = str(scn.path) if scenario_file is None else scenario_file  # the name messages give the file
     iset = InstrumentSet(scn.vessel, scn.head.seed, scn.site, scn.instrument_items, f, stream=stream,
                          wind_profile=(scn.wind.profile_exponent, scn.wind.reference_height_m))
+    if any(d.kind == "wave_probe" for d in iset.devices.values()):
+        field = wave_field(scn)  # wave probes see the scenario's sea surface
+        if field is not None:
+            iset.set_seaway(field.components)
     if iset.needs_sea:  # wave buoys, wave radar, relative-motion meter read the seaway itself (opt-in)
         iset.attach_sea(wave_field(scn))
     return iset

@@ -684,6 +684,39 @@ class Attitude(Device):
         return np.column_stack([cols["roll"], cols["pitch"]])
 
 
+class WaveProbe(Device):
+    """Motion-compensated wave probe on a boom ahead of the bow (a shipborne wave meter: downward range
+    sensor plus a heave accelerometer at the same point, Tucker 1956): the surface elevation (up) of the
+    incident seaway at the site's horizontal position, a point that moves with the ship — the encounter-
+    frame wave input of a seakeeping trial. The simulated sea has no radiated or diffracted waves, so
+    the footprint ahead of the stem sees the incident wave; the motion compensation's own errors are
+    lumped into the chain's gain error, noise and resolution. The seaway components are set by
+    :meth:`set_seaway` (calm: elevation 0)."""
+
+    kind = "wave_probe"
+    channels = {"elevation": ("m", "surface elevation at the probe footprint (up)")}
+
+    def build(self):
+        super().build()
+        self.components = np.zeros((0, 6))
+
+    def set_seaway(self, components) -> None:
+        self.components = np.asarray(components, dtype=float).reshape(-1, 6)
+
+    def measurand(self, kin, cols):
+        if self.components.shape[0] == 0 or cols["t"].size == 0:
+            return np.zeros(cols["t"].size)
+        from vtrials.physics.environment.waves import elevation
+        pos = kin.position()
+        return elevation(self.components, pos[:, 0], pos[:, 1], cols["t"])
+
+    def meta(self):
+        m = super().meta()
+        sm, ss = _dist(self.spec, "scale")
+        m["scale_std"] = ss  # the stated gain accuracy of the probe (1σ, fraction)
+        return m
+
+
 class IMU(Device):
     """Strapdown motion package at its site: triaxial accelerometers (specific force, including the
     lever-arm centripetal and tangential terms) and rate gyros, each with bias, bias instability
@@ -1250,6 +1283,6 @@ class RudderAngle(Device):
 
 KINDS = {"gnss": GNSS, "range_radar": RangeRadar, "acoustic_range": AcousticRange, "loran": Loran,
          "knotmeter": Knotmeter, "em_log": EMLog, "doppler_log": DopplerLog, "heading": Heading,
-         "attitude": Attitude, "imu": IMU, "anemometer": Anemometer,
+         "attitude": Attitude, "imu": IMU, "wave_probe": WaveProbe, "anemometer": Anemometer,
          "sonic_anemometer": SonicAnemometer, "accelerometer_array": AccelerometerArray, "shaft_torque": ShaftTorque,
          "shaft_rpm": ShaftSpeed, "thrust": Thrustmeter, "pitch_indicator": PitchIndicator, "rudder": RudderAngle}

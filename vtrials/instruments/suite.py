@@ -293,6 +293,12 @@ class InstrumentSet:
         except SpecError as exc:
             raise InputError(f, f"{where}.{exc.field}", exc.problem) from None
 
+    def set_seaway(self, components) -> None:
+        """Give the devices that sense the sea surface (wave probes) the seaway's components (n, 6)."""
+        for dev in self.devices.values():
+            if hasattr(dev, "set_seaway"):
+                dev.set_seaway(components)
+
     # ------------------------------------------------------------------ running
     def reset(self) -> None:
         for name, dev in self.devices.items():

@@ -630,4 +630,7 @@ def reduce_record(rec: Record) -> dict:
     if kind == "airwake_survey":
         from vtrials.reduce.airwake_survey import reduce_airwake_survey
         return reduce_airwake_survey(rec)
+    if kind == "seakeeping":
+        from vtrials.reduce.seakeeping import reduce_seakeeping
+        return reduce_seakeeping(rec)
     raise ValueError(f"{rec.path}: no reduction for trial kind {kind!r}")

@@ -391,4 +391,7 @@ def score_trial(kind: str, reduced: dict, res, name: str) -> dict:
     if kind == "airwake_survey":
         from vtrials.score.airwake import score_airwake_survey
         return score_airwake_survey(reduced, res, name)
+    if kind == "seakeeping":
+        from vtrials.score.seakeeping import score_seakeeping
+        return score_seakeeping(reduced, res, name)
     raise ValueError(f"no scoring for trial kind {kind!r}")

@@ -17,6 +17,12 @@ one after another on one ship:
     bow, ``relative_wind_kn``, or a fixed shaft setting whose speed the wind then gives), and the
     ``positions`` (deck sockets, ``models/<ship>/airwake.toml`` ``[mast]``) the mobile anemometer mast
     is moved among: one recording of ``record_s`` per position (seed 003: 13 positions, 90 s each).
+``[[agenda.trial]] kind = "seakeeping"``
+    ``[[agenda.trial.leg]]``: the star pattern of a seakeeping trial (seed 004 Table 1): one leg per
+    table, its heading named relative to the mean wave direction the team observes (``head``,
+    ``bow_starboard`` … ``following``; the course is resolved by the crew at the start of the leg), a
+    setting (order or r/min) and the leg's length (default 25 min); ``station_keeping`` marks the
+    low-speed head-seas legs at the start and end.
 
 Everything is checked when the scenario is loaded, before anything runs: unknown trial kinds, a spot
 with one run, headings that cannot form a four-leg set, settings the machinery cannot give.
@@ -92,7 +98,8 @@ class AgendaRules:
 @dataclasses.dataclass(frozen=True)
 class TrialHead:
     name: str = text("name of the trial (its record file is records/<name>.nc)")
-    kind: str = text("kind of trial", ("standardization", "log_calibration", "maneuvering", "airwake_survey"))
+    kind: str = text("kind of trial", ("standardization", "log_calibration", "maneuvering", "airwake_survey",
+                                       "seakeeping"))
     run_s: float = num("length of each measured run (EXECUTE to FINEX)", "s", 10.0, 7200.0, default=180.0)
     autopilot_rudder_deg: float = num("override of the agenda's helm rudder limit for this trial", "deg",
                                       0.0, 35.0, lo_open=True, default=None)
@@ -186,6 +193,23 @@ class AirwakeCondition(Setting):
                                     45.0, lo_open=True, default=5.0)
     wind_tolerance_kn: float = num("relative wind speed the crew accepts as on the ordered one", "kn", 0.0, 20.0,
                                    lo_open=True, default=1.5)
+# angle off the bow [deg] from which the waves come on each named seakeeping leg (+ starboard);
+# the ordered course is the observed mean wave direction (from) minus this angle
+WAVE_RELATIVE_DEG = {"head": 0.0, "bow_starboard": 45.0, "beam_starboard": 90.0, "quarter_starboard": 135.0,
+                     "following": 180.0, "quarter_port": -135.0, "beam_port": -90.0, "bow_port": -45.0}
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class SeakeepingLeg(Setting):
+    """One leg of a seakeeping star pattern (seed 004 Table 1): a heading relative to the waves and a
+    setting, held for ``leg_s`` by the course-keeping helm while the motions are recorded."""
+
+    heading: str = text("where the waves come from relative to the bow", tuple(WAVE_RELATIVE_DEG))
+    leg_s: float = num("length of the leg, EXECUTE to FINEX (seed 004: about 25 min)", "s", 60.0, 7200.0,
+                       default=1500.0)
+    station_keeping: bool = flag("a station-keeping leg (low speed, head seas) at the start or end of the "
+                                 "pattern", default=False)
+    label: str = text("name of the leg in the log (default: heading and setting)", default=None)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -226,7 +250,8 @@ class Agenda:
 
 
 _ITEMS = {"standardization": ("spot", SpotSpec), "log_calibration": ("speed", SpeedSpec),
-          "maneuvering": ("run", ManeuverSpec), "airwake_survey": ("condition", AirwakeCondition)}
+          "maneuvering": ("run", ManeuverSpec), "airwake_survey": ("condition", AirwakeCondition),
+          "seakeeping": ("leg", SeakeepingLeg)}
 
 
 def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None, tuple, str | None]:
@@ -340,6 +365,11 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
             if kind == "maneuvering":
                 runs.append(_maneuver_run(spec, number + 1, head.name, ii, rps, pitch, modes, order, base, limit,
                                           vessel, f, isec))
+                number += 1
+                continue
+            if kind == "seakeeping":
+                runs.append(_seakeeping_run(spec, number + 1, head.name, ii, rps, pitch, modes, order, base, limit,
+                                            f, isec))
                 number += 1
                 continue
             if spec.order is not None and spec.order not in ORDERS:
@@ -509,8 +539,27 @@ def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pit
                f"{what}{extra}"[:40], order, p)
 
 
+def _seakeeping_run(leg: SeakeepingLeg, number: int, trial: str, index: int, rps, pitch, modes, order,
+                    base: float, limit: float, f: str, sec: str) -> Run:
+    """One seakeeping leg in SI: the course is resolved at sea from the observed wave direction
+    (``params['wave_relative']``, rad); ``heading`` holds the base course until then."""
+    if leg.station_keeping and leg.heading != "head":
+        raise InputError(f, f"{sec}.heading", f"a station-keeping leg is held head to the sea; got {leg.heading!r}")
+    if order is not None and order not in ORDERS:
+        raise InputError(f, f"{sec}.order", f"a seakeeping leg needs an ahead order ({', '.join(ORDERS)}); "
+                                            f"got {order!r}")
+    setting = order if order is not None else f"{leg.rpm:g} rpm"
+    label = leg.label or (f"{'station keeping' if leg.station_keeping else leg.heading.replace('_', ' ')} "
+                          f"{setting}")[:40]
+    p = {"type": "seakeeping", "wave_relative": WAVE_RELATIVE_DEG[leg.heading] * DEG, "wave_heading": leg.heading,
+         "station_keeping": bool(leg.station_keeping)}
+    return Run(number, trial, "seakeeping", base * DEG, rps, pitch, modes, leg.leg_s, limit * DEG, index + 1, 1,
+               label, order, p)
+
+
 def agenda_keys() -> list[str]:
     return [f.name for f in dataclasses.fields(AgendaRules)] + ["steadiness", "trial"]
 
 
-__all__ = ["Agenda", "AgendaRules", "Run", "Steadiness", "Trial", "load_agenda", "unknown_key"]
+__all__ = ["Agenda", "AgendaRules", "Run", "SeakeepingLeg", "Steadiness", "Trial", "WAVE_RELATIVE_DEG", "load_agenda",
+           "unknown_key"]

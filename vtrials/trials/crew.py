@@ -544,6 +544,8 @@ class Crew:
         if run.kind == "airwake":
             from vtrials.trials import airwake_survey
             return airwake_survey.execute(self, run, attempt)
+        if run.kind == "seakeeping":
+            return self.execute_seakeeping(run, attempt)
         if run.kind != "speed":
             return self.execute_maneuver(run, attempt)
         att = Attempt(run, attempt, math.degrees(run.heading) % 360.0, [], [], list(run.modes), self.t)
@@ -575,6 +577,39 @@ class Crew:
         ok, why = judge(self.display(att.t_execute), run.heading, self.st, run.modes, self._torque_floor)
         att.run_steady, att.run_notes = ok, why
         ref = window_truth(self.recent_truth(), att.t_execute, att.t_finex)
+        ref.update({"run": run.number, "attempt": attempt})
+        self.truth_refs.append(ref)
+        self._runs_done += 1
+        self.attempts.append(att)
+        return att
+
+    # ------------------------------------------------------------------ seakeeping legs
+    def execute_seakeeping(self, run: Run, attempt: int) -> Attempt:
+        """A leg of the star pattern: come to the course relative to the observed waves, settle, COMEX,
+        approach, EXECUTE, hold the course for the leg, FINEX (no measured-course placement)."""
+        from vtrials.trials import seakeeping as SK
+        course = SK.leg_course(self.iset.team, run)
+        run = dataclasses.replace(run, heading=course)
+        att = Attempt(run, attempt, math.degrees(course) % 360.0, [], [], list(run.modes), self.t)
+        self.set_shafts(run)
+        self.come_to(course, run.helm_limit)
+        self.settle(run, att)
+        att.rpm_ordered = [x / RPM for x in self.rps_order]
+        att.pitch_ordered = [x if self._cp[k] else None for k, x in enumerate(self.pitch_order)]
+        self.hold(course, run.helm_limit)
+        att.t_comex = self.t
+        self.events.append((self.t, run.number, EV_COMEX))
+        self.advance(self.rules.approach_s)
+        att.t_execute = self.t
+        self.events.append((self.t, run.number, EV_EXECUTE))
+        self.advance(run.duration)
+        att.t_finex = self.t
+        self.events.append((self.t, run.number, EV_FINEX))
+        ok, why = judge(self.display(att.t_execute), course, self.st, run.modes, self._torque_floor)
+        att.run_steady, att.run_notes = ok, why
+        cols = self.recent_truth()
+        ref = window_truth(cols, att.t_execute, att.t_finex)
+        ref.update(SK.leg_truth(cols, att.t_execute, att.t_finex, SK.motion_site(self.iset)))
         ref.update({"run": run.number, "attempt": attempt})
         self.truth_refs.append(ref)
         self._runs_done += 1

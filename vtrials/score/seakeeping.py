@@ -1,0 +1,239 @@
+"""Scoring a seakeeping trial: each leg's transfer functions against the true ones of the simulated
+ship in the realised sea, its RMS motions against the true motions, the probe's H_s against the sea's.
+
+True transfer function of a leg (what H₁ estimates, computed from truth, never from the records):
+
+* the ship's RAO per wave component j (amplitude a_j, frequency ω_j, direction μ_j) at the leg's true
+  mean speed through the water U and heading ψ, relative heading β_j = μ_j − ψ: the coupled six-DOF RAO
+  of the system the simulator integrates (:func:`vtrials.physics.seakeeping.linearize.coupled_rao`:
+  maneuvering model in the horizontal DOFs, the ship's heading autopilot and steering gear, radiation
+  memory, the quadratic roll damping linearised stochastically at the roll-rate RMS predicted for this
+  sea, iterated); its phase refers to a crest at the body origin O;
+* at the probe's footprint r_p = (x_p, y_p) the wave phase is −k_j(x_p cos β_j + y_p sin β_j), so the
+  component's probe-referred transfer function is RAO_j e^{+i k_j (x_p cos β_j + y_p sin β_j)}; heave of
+  the IMU's site (up) is −(ξ₃ + y_s ξ₄ − x_s ξ₅), its vertical acceleration −ω_e² times that; roll ξ₄,
+  pitch ξ₅. Components met at a negative encounter frequency ω_e,j = ω_j − k_j V_g·(cos μ_j, sin μ_j)
+  (V_g the true mean ground velocity: the waves are fixed to the earth) are recorded at |ω_e,j| with the
+  conjugate transfer function; components outside the hydrodynamic database's band do not move the
+  ship (as in :func:`vtrials.scenario.sea_vessel`);
+* in a Welch bin ω_b the expected cross-spectra are the components' sums weighted by the Hann
+  window's spectral window |W(|ω_e,j| − ω_b)|² (segment length T_s: W ∝ sinc(x)/(1 − x²), x =
+  (|ω_e,j| − ω_b) T_s/2π): H_true(ω_b) = Σ a_j² W_jb H_j / Σ a_j² W_jb. In a short-crested sea this is a
+  direction-average of the RAO (the point probe cannot separate directions); the long-crested RAO at the
+  sea's mean direction (``H_rao_mean_direction``) is reported beside it.
+
+Scored where the reduced coherence exceeds 0.8 (issue 13): relative amplitude error, phase error,
+whether the 95 % intervals cover the truth.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vtrials.units import G
+
+RESP = ("heave", "vertical_acc", "roll", "pitch")
+
+
+def _window_weight(x: np.ndarray) -> np.ndarray:
+    """|W|² of the Hann window at x bins from its centre (continuous-time form, normalised to 1 at 0)."""
+    x = np.asarray(x, float)
+    d = 1.0 - x * x
+    near = np.abs(d) < 1e-9
+    w = np.where(near, 0.5, np.sinc(x) / np.where(near, 1.0, d))
+    return w * w
+
+
+class _ShipModel:
+    """The simulated ship's linearisation pieces, built once per scenario (speed-dependent parts cached)."""
+
+    def __init__(self, scn):
+        from vtrials.physics.seakeeping.database import load_database
+        from vtrials.physics.seakeeping.sea_ship import sea_ship
+        from vtrials.physics.seakeeping.timedomain import roll_damping_of
+        from vtrials.scenario import hydro_path
+        self.scn = scn
+        self.ves = scn.vessel
+        self.db = load_database(hydro_path(scn.vessel))
+        self.dt = scn.head.timestep_s
+        self.v0, _ = sea_ship(scn.vessel, self.db, np.zeros((0, 6)), self.dt, mean_force="none")
+        self.rd = roll_damping_of(scn.vessel, self.db)
+        self._jac = {}
+
+    def jacobians(self, U: float):
+        from vtrials.physics.seakeeping import linearize as LZ
+        from vtrials.physics.simulator import Simulator
+        key = round(U, 3)
+        if key not in self._jac:
+            start = Simulator(self.ves, 1, self.dt).self_propulsion(0, U)
+            _, Jv, Je, Jd = LZ.force_jacobians(self.v0, start, self.dt)
+            Jc = LZ.coriolis_jacobian(self.v0, start.u)
+            self._jac[key] = (start.u, Jv, Je, Jd, Jc)
+        return self._jac[key]
+
+    def raos(self, omega, beta, U: float, helm_limit: float | None = None):
+        """(n, 6) coupled RAOs of components (ω_j, β_j) at U, roll damping linearised for this sea."""
+        from vtrials.physics.seakeeping import linearize as LZ
+        from vtrials.physics.seakeeping.rao import encounter_frequency
+        u, Jv, Je, Jd, Jc = self.jacobians(U)
+        ap = self.ves.autopilot
+        auto = (*ap.pid, float(self.ves.steering[0, 2]))
+        return u, Jv, Je, Jd, Jc, auto
+
+    def component_raos(self, comp: np.ndarray, psi: float, U: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """RAOs (n, 6) of every component at heading ψ and speed U, their β, and the roll-rate RMS used."""
+        from vtrials.physics.seakeeping import linearize as LZ
+        from vtrials.physics.seakeeping.rao import encounter_frequency
+        u, Jv, Je, Jd, Jc, auto = self.raos(None, None, U)
+        mu = np.arctan2(comp[:, 4], comp[:, 3])
+        beta = np.remainder(mu - psi + math.pi, 2 * math.pi) - math.pi
+        n = comp.shape[0]
+        R = np.zeros((n, 6), dtype=complex)
+        we = encounter_frequency(comp[:, 1], beta, U, self.db.g)
+        sigma_p = 0.0
+        b1 = float(self.rd.B1(U))
+        for _ in range(30):
+            beq = float(self.rd.stochastic(U, sigma_p)) - b1  # B₁ is in J_ν already
+            for j in range(n):
+                R[j] = LZ.coupled_rao(self.v0, self.db, comp[j:j + 1, 1], float(beta[j]), U, Jv, Je, Jc, roll_beq=beq,
+                                      Jd=Jd, autopilot=auto)[0]
+            new = math.sqrt(float(np.sum(0.5 * comp[:, 0] ** 2 * np.abs(we * R[:, 3]) ** 2)))
+            if abs(new - sigma_p) <= 1e-4 * max(new, 1e-9):
+                sigma_p = new
+                break
+            sigma_p = new
+        return R, beta, sigma_p
+
+
+def true_transfer(model: _ShipModel, comp: np.ndarray, ref: dict, leg: dict, probe_xy, imu_xy) -> dict:
+    """Probe-referred true transfer functions on the leg's Welch bins (module doc)."""
+    db = model.db
+    U = float(ref["u_r_mean"])
+    psi = float(ref["heading"])
+    vg = np.asarray(ref["ground_velocity_ne"], float)
+    band = (comp[:, 1] >= 0.5 * db.omega[0]) & (comp[:, 1] <= db.omega[-1])
+    R = np.zeros((comp.shape[0], 6), dtype=complex)
+    Rb, beta_b, sigma_p = model.component_raos(comp[band], psi, U)
+    R[band] = Rb
+    mu = np.arctan2(comp[:, 4], comp[:, 3])
+    beta = np.remainder(mu - psi + math.pi, 2 * math.pi) - math.pi
+    k = comp[:, 2]
+    we = comp[:, 1] - k * (vg[0] * comp[:, 3] + vg[1] * comp[:, 4])
+    xp, yp = probe_xy
+    xs, ys = imu_xy
+    ph = np.exp(1j * k * (xp * np.cos(beta) + yp * np.sin(beta)))
+    heave = -(R[:, 2] + ys * R[:, 3] - xs * R[:, 4])
+    H = {"heave": heave, "vertical_acc": -we ** 2 * heave, "roll": R[:, 3], "pitch": R[:, 4]}
+    wb = np.asarray(leg["omega_e"], float)
+    Ts = float(leg["segment_s"])
+    x = (np.abs(we)[:, None] - wb[None, :]) * Ts / (2 * math.pi)
+    Wt = _window_weight(x) * (0.5 * comp[:, 0] ** 2)[:, None]  # (n, nb)
+    sxx = Wt.sum(axis=0)
+    out = {"u_r": U, "heading": psi, "sigma_roll_rate": sigma_p, "probe_variance_in_bins": sxx.tolist()}
+    neg = we < 0
+    for name, h in H.items():
+        hp = h * ph
+        hp = np.where(neg, np.conj(hp), hp)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            Ht = (Wt * hp[:, None]).sum(axis=0) / sxx
+            coh = np.abs((Wt * hp[:, None]).sum(axis=0)) ** 2 / (sxx * (Wt * np.abs(hp[:, None]) ** 2).sum(axis=0))
+        out[name] = {"H_re": Ht.real.tolist(), "H_im": Ht.imag.tolist(), "coherence": coh.tolist()}
+    # the long-crested RAO at the sea's true mean direction (for the plots), where ω_e has one wave frequency
+    from vtrials.reduce.encounter import wave_frequencies
+    w = model.scn.waves
+    mu0 = math.radians(w.direction_deg) + math.pi
+    beta0 = math.remainder(mu0 - psi, 2 * math.pi)
+    W = wave_frequencies(wb, U, beta0)
+    unique = ~np.isfinite(W[:, 1]) & np.isfinite(W[:, 0]) & (W[:, 0] >= db.omega[0]) & (W[:, 0] <= db.omega[-1])
+    from vtrials.physics.seakeeping import linearize as LZ
+    u, Jv, Je, Jd, Jc, auto = model.raos(None, None, U)
+    beq = float(model.rd.stochastic(U, sigma_p)) - float(model.rd.B1(U))
+    rao0 = {n: np.full(wb.size, np.nan + 0j) for n in RESP}
+    if np.any(unique):
+        om = W[unique, 0]
+        R0 = LZ.coupled_rao(model.v0, db, om, beta0, U, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto)
+        k0 = om ** 2 / G
+        we0 = om - k0 * U * math.cos(beta0)
+        ph0 = np.exp(1j * k0 * (xp * math.cos(beta0) + yp * math.sin(beta0)))
+        hv = -(R0[:, 2] + ys * R0[:, 3] - xs * R0[:, 4])
+        for n, h in (("heave", hv), ("vertical_acc", -we0 ** 2 * hv), ("roll", R0[:, 3]), ("pitch", R0[:, 4])):
+            rao0[n][unique] = h * ph0
+    for n in RESP:
+        out[n]["H_rao_mean_direction_re"] = rao0[n].real.tolist()
+        out[n]["H_rao_mean_direction_im"] = rao0[n].imag.tolist()
+    return out
+
+
+def _score_tf(red: dict, tru: dict, wb: np.ndarray, coh_min: float, omega_min: float) -> dict:
+    H = np.asarray(red["H_re"]) + 1j * np.asarray(red["H_im"])
+    Ht = np.asarray(tru["H_re"]) + 1j * np.asarray(tru["H_im"])
+    coh = np.asarray(red["coherence"])
+    sel = (coh > coh_min) & (wb > omega_min) & np.isfinite(Ht) & (np.abs(Ht) > 0)
+    amp_err = np.abs(H) / np.abs(Ht) - 1.0
+    ph_err = np.angle(H * np.conj(Ht))
+    lo, hi = np.asarray(red["amp_lo95"]), np.asarray(red["amp_hi95"])
+    eps = np.asarray(red["error"])
+    cov_a = (lo <= np.abs(Ht)) & (np.abs(Ht) <= hi)
+    cov_p = np.abs(ph_err) <= 1.959963984540054 * eps
+    n = int(sel.sum())
+    d = {"bins": n, "omega_e": wb[sel].tolist(), "amp_error": amp_err[sel].tolist(), "phase_error": ph_err[sel].tolist(),
+         "amp_covered": cov_a[sel].tolist(), "phase_covered": cov_p[sel].tolist(),
+         "amp_half_width": (0.5 * (hi - lo) / np.abs(Ht))[sel].tolist()}
+    if n:
+        d.update({"median_abs_amp_error": float(np.median(np.abs(amp_err[sel]))),
+                  "max_abs_amp_error": float(np.max(np.abs(amp_err[sel]))),
+                  "within_10pct": float(np.mean(np.abs(amp_err[sel]) <= 0.10)),
+                  "amp_coverage": float(np.mean(cov_a[sel])), "phase_coverage": float(np.mean(cov_p[sel]))})
+    return d
+
+
+def score_seakeeping(reduced: dict, res, name: str) -> dict:
+    """Per leg: the true transfer functions and motions, the errors and coverage (module doc)."""
+    from vtrials.scenario import wave_field
+    from vtrials.score.trials import _truth_of
+    scn = res.scenario
+    truth = _truth_of(res.crew, name)
+    field = wave_field(scn)
+    comp = field.components
+    model = _ShipModel(scn)
+    iset = res.crew.iset
+    probe = [d for d in iset.devices.values() if d.kind == "wave_probe"]
+    imu = [d for d in iset.devices.values() if d.kind == "imu"]
+    hs_true = 4.0 * math.sqrt(float(np.sum(0.5 * comp[:, 0] ** 2)))
+    legs = []
+    coh_min = float(reduced.get("coherence_min", 0.8))
+    for leg in reduced.get("legs", []):
+        ref = truth.get(leg["run"])
+        if ref is None or not probe or not imu:
+            continue
+        tt = true_transfer(model, comp, ref, leg, probe[0].site[:2], imu[0].site[:2])
+        wb = np.asarray(leg["omega_e"], float)
+        sc = {"run": leg["run"], "label": leg["label"], "truth": {"hs": hs_true, "u_r": ref["u_r_mean"],
+                                                                   "heading": ref["heading"], "stw": ref["stw"]}}
+        h = leg["hs_probe"]
+        sc["hs_probe"] = {"truth": hs_true, "reduced": h["value"], "error": h["value"] / hs_true - 1.0,
+                          "covered": bool(h["lo95"] <= hs_true <= h["hi95"])}
+        sc["rms"] = {}
+        sc["transfer"] = {}
+        for n in RESP:
+            r = leg["responses"][n]
+            tr = ref.get(f"{n}_rms")
+            if tr is not None:
+                sc["rms"][n] = {"truth": tr, "reduced": r["rms"]["value"], "error": r["rms"]["value"] / tr - 1.0,
+                                "lo95": r["rms"]["lo95"], "hi95": r["rms"]["hi95"]}
+            sc["transfer"][n] = _score_tf(r, tt[n], wb, coh_min, 1.2 * float(leg["omega_c"]))
+        sc["true_transfer"] = tt
+        legs.append(sc)
+    summary = {}
+    for n in RESP:
+        errs = [e for L in legs for e in L["transfer"][n]["amp_error"]]
+        cov = [c for L in legs for c in L["transfer"][n]["amp_covered"]]
+        pcov = [c for L in legs for c in L["transfer"][n]["phase_covered"]]
+        if errs:
+            a = np.abs(np.asarray(errs))
+            summary[n] = {"bins": len(errs), "median_abs_amp_error": float(np.median(a)), "max_abs_amp_error": float(a.max()),
+                          "within_10pct": float(np.mean(a <= 0.10)), "amp_coverage": float(np.mean(cov)),
+                          "phase_coverage": float(np.mean(pcov))}
+    return {"reduced": reduced, "truth": {"hs": hs_true}, "legs": legs, "summary": summary}
