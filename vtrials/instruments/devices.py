@@ -902,6 +902,213 @@ class Anemometer(Device):
         return m
 
 
+#: time constant [s] of each of the two cascaded first-order filters that define the ship's "mean
+#: motion" for the airwake (the flow round the hull follows the ship's slow velocity, not its wave-frequency
+#: oscillation: the oscillating instrument moves through a quasi-steady distorted flow). 2 × 15 s keeps
+#: 0.5 % of a 7-s wave-frequency velocity and settles a speed change in about 90 s (assumption).
+AIRWAKE_MEAN_MOTION_TAU_S = 15.0
+
+
+@nb.njit(cache=True)
+def _two_lags(t, x, a1, a2, tl, tau):
+    y = np.empty_like(x)
+    for k in range(t.size):
+        al = 1.0 - math.exp(-max(t[k] - tl, 0.0) / tau)
+        for j in range(x.shape[1]):
+            a1[j] += al * (x[k, j] - a1[j])
+            a2[j] += al * (a1[j] - a2[j])
+            y[k, j] = a2[j]
+        tl = t[k]
+    return y, tl
+
+
+def _mean_motion_filter(t, x, state):
+    """Two cascaded first-order low-passes (τ = AIRWAKE_MEAN_MOTION_TAU_S, exact for a sample hold)
+    of x (n, k), streaming: state = (y1, y2, t_last) or None (start at x[0])."""
+    if state is None:
+        state = (x[0].copy(), x[0].copy(), float(t[0]))
+    a1, a2, tl = state[0].copy(), state[1].copy(), state[2]
+    y, tl = _two_lags(np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(x, dtype=np.float64),
+                      a1, a2, float(tl), AIRWAKE_MEAN_MOTION_TAU_S)
+    return y, (a1, a2, tl)
+
+
+class SonicAnemometer(Device):
+    """Three-axis ultrasonic anemometer (e.g. on a mobile airwake mast): the air velocity relative to
+    the instrument, (u, v, w) in the ship's body axes (x fwd, y stbd, z down) — what seed 003's AWSM
+    takes. The air at the head: the true wind at its height (power-law profile, as :class:`Anemometer`),
+    relative to the ship's MEAN motion (:data:`AIRWAKE_MEAN_MOTION_TAU_S`), distorted by the ship's airwake
+    at the site (:mod:`vtrials.instruments.airwake`, in ship-carried vertical axes), plus that mean motion;
+    then minus the head's own velocity (ship velocity and ω × ρ, the motion-induced part). Errors: a common
+    misalignment of the transducer head, per-axis scale, bias, white noise, resolution.
+
+    A mobile mast (``mobile = true``) is moved between deck sockets by the crew (:meth:`move_to`); the
+    ``position`` channel logs which socket (its index in the ``positions`` attribute). The simulator keeps
+    the truth of every sample in memory (:meth:`truth_series`) for the scorer; records never carry it."""
+
+    kind = "sonic_anemometer"
+    extra_keys = {"mobile"}
+    channels = {"u": ("m s-1", "air velocity relative to the instrument, body x (+ towards the bow)"),
+                "v": ("m s-1", "air velocity relative to the instrument, body y (+ towards starboard)"),
+                "w": ("m s-1", "air velocity relative to the instrument, body z (+ downwards)"),
+                "position": ("1", "mast position code: index into the positions attribute")}
+    n_axes = 3
+    profile = (TRIALS_PROFILE_EXPONENT, Z_REF_10)
+
+    def build(self):
+        s = self.spec
+        self.mobile = bool(s.get("mobile", False))
+        self.clock = P.Resample(float(s["rate_hz"]))
+        self.err = value_chain({k: v for k, v in s.items() if k != "rate_hz"}, self.f, 3, sampling=[])
+        self.chain = P.Chain([self.clock])
+        self.airwake = None  # vtrials.instruments.airwake.Airwake, set by the instrument set
+        self.position_names = [self.site_name]
+        self.position_sites = {self.site_name: self.site}
+
+    def set_airwake(self, airwake, vessel_sites: dict) -> None:
+        """The ship's airwake (truth) and, for a mobile mast, its deck sockets (surveyed sites)."""
+        self.airwake = airwake
+        if self.mobile and airwake is not None and airwake.mast_positions:
+            names = list(airwake.mast_positions)
+            if self.site_name not in names:
+                names = [self.site_name] + names
+            self.position_names = names
+            self.position_sites = {n: np.asarray(vessel_sites[n], float) for n in names}
+
+    def reset(self, rng):
+        r1, r2 = rng.spawn(2)
+        self.clock.reset(r1)
+        self.err.reset(r2)
+        self._moves = [(-math.inf, self.site_name)]
+        self._state = None
+        self._truth = []
+
+    def move_to(self, t: float, site: str) -> None:
+        """The crew steps the mast in socket ``site`` at time t [s] (readings after t are from there)."""
+        if site not in self.position_sites:
+            raise ValueError(f"{self.name}: {site!r} is not a position of this mast ({', '.join(self.position_names)})")
+        if t < self._moves[-1][0]:
+            raise ValueError(f"{self.name}: moves must come in time order")
+        self._moves.append((float(t), site))
+
+    def position_at(self, t: np.ndarray) -> list:
+        """Socket name per time."""
+        tm = np.array([m[0] for m in self._moves])
+        idx = np.searchsorted(tm, t, side="right") - 1
+        return [self._moves[i][1] for i in idx]
+
+    def _site_airwake(self, name):
+        from vtrials.instruments.airwake import NONE
+        if self.airwake is None or name not in self.airwake.sites:
+            return NONE
+        return self.airwake.sites[name]
+
+    def true_velocities(self, cols: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(error-free reading m (n, 3) body axes, local air velocity over ground at the head (n, 3) NED,
+        ship (origin) velocity over ground (n, 3) NED) at the truth rows of ``cols``; advances the
+        mean-motion filter."""
+        t = cols["t"]
+        n = t.size
+        R = SiteKinematics(cols, self.site).R
+        names = self.position_at(t)
+        r = np.array([self.position_sites[x] for x in names]).reshape(n, 3)
+        nu = np.column_stack([cols["u"], cols["v"], cols["w"]])
+        om = np.column_stack([cols["p"], cols["q"], cols["r"]])
+        v_ned = np.einsum("nij,nj->ni", R, nu)
+        slow, self._state = _mean_motion_filter(t, v_ned, self._state)
+        h = -(cols["z"] + np.einsum("nj,nj->n", R[:, 2, :], r))
+        exponent, z_ref = self.profile
+        U = cols["wind_speed"] * (np.maximum(h, 0.5) / z_ref) ** exponent
+        d = cols["wind_direction"]
+        W = np.column_stack([-U * np.cos(d), -U * np.sin(d), np.zeros(n)])
+        psi = cols["heading"]
+        cp, sp = np.cos(psi), np.sin(psi)
+        z0, o1 = np.zeros(n), np.ones(n)
+        Rz = np.stack([np.stack([cp, -sp, z0], -1), np.stack([sp, cp, z0], -1), np.stack([z0, z0, o1], -1)], -2)
+        rel = np.einsum("nji,nj->ni", Rz, W - slow)  # Rzᵀ (W − V̄): level axes along the heading
+        a_v = np.empty_like(rel)
+        for name in set(names):
+            sel = np.array([x == name for x in names])
+            a_v[sel] = self._site_airwake(name).local(rel[sel])
+        air = slow + np.einsum("nij,nj->ni", Rz, a_v)
+        m = np.einsum("nji,nj->ni", R, air) - (nu + np.cross(om, r))
+        return m, air, v_ned
+
+    def process(self, cols):
+        t = cols["t"]
+        m, air, v_ned = self.true_velocities(cols)
+        ang = np.column_stack([cols["roll"], cols["pitch"], cols["heading"]])
+        tt, y = self.clock.process(t, np.column_stack([m, air, v_ned, ang]))
+        code = np.array([self.position_names.index(x) for x in self.position_at(tt)], float)
+        if tt.size:
+            self._truth.append((tt, y[:, 0:3], y[:, 3:6], y[:, 6:9], y[:, 9:12], code))
+        _, mm = self.err.process(tt, y[:, :3])
+        return tt, {"u": mm[:, 0], "v": mm[:, 1], "w": mm[:, 2], "position": code}
+
+    def truth_series(self) -> dict:
+        """The truth of every emitted sample (true time): the error-free reading (body axes), the local
+        air velocity over ground at the head (airwake included) and the ship's velocity over ground
+        (NED), roll, pitch, heading (unwrapped), position code."""
+        keys = ("t", "reading", "air", "ship_velocity", "euler", "position")
+        if not self._truth:
+            return {k: np.zeros((0, 3)) if k in ("reading", "air", "ship_velocity", "euler") else np.zeros(0)
+                    for k in keys}
+        return {k: np.concatenate([x[i] for x in self._truth]) for i, k in enumerate(keys)}
+
+    def drawn(self):
+        return {"clock": self.clock.drawn(), "errors": self.err.drawn(),
+                "moves": [[m[0], m[1]] for m in self._moves[1:]]}
+
+    def meta(self):
+        m = super().meta()
+        s = self.spec
+        m.update({"mobile": self.mobile, "positions": self.position_names,
+                  "position_sites_m": [self.position_sites[n].tolist() for n in self.position_names],
+                  "noise_std": float(s.get("noise", 0.0)) * self.f,
+                  "scale_sd": float(_dist(s, "scale")[1]),
+                  "misalignment_sd_rad": float(s.get("misalignment_deg", 0.0)) * DEG})
+        return m
+
+
+class AccelerometerArray(Device):
+    """A rigid array of single-axis linear accelerometers (Miles 1986, seed 001): sensor j at
+    ``positions_m[j]`` from the array's site (body axes), sensitive axis ``axes[j]`` (unit vector),
+    reads e_j · f at its point (specific force incl. the lever-arm terms, :class:`SiteKinematics`);
+    per-sensor bias, scale, white noise, resolution from the common keys."""
+
+    kind = "accelerometer_array"
+    extra_keys = {"positions_m", "axes"}
+
+    def build(self):
+        s = self.spec
+        p = np.asarray(s.get("positions_m", []), float)
+        e = np.asarray(s.get("axes", []), float)
+        if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 6:
+            raise SpecError("positions_m", f"shape {p.shape}; allowed: at least 6 points [x, y, z] [m]")
+        if e.shape != p.shape:
+            raise SpecError("axes", f"shape {e.shape}; allowed: {p.shape} (one axis per sensor)")
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(e))) or np.any(np.abs(np.linalg.norm(e, axis=1) - 1) > 1e-6):
+            raise SpecError("axes", "finite unit vectors required")
+        self.offsets, self.axes = p, e
+        self.n_axes = p.shape[0]
+        self.channels = {f"a{j + 1}": ("m s-2", f"specific force along axis {e[j].tolist()} at {p[j].tolist()} m")
+                         for j in range(self.n_axes)}
+        self.chain = value_chain(s, self.f, self.n_axes)
+
+    def measurand(self, kin, cols):
+        out = np.empty((cols["t"].size, self.n_axes))
+        for j in range(self.n_axes):
+            f = SiteKinematics(cols, self.site + self.offsets[j]).specific_force()
+            out[:, j] = f @ self.axes[j]
+        return out
+
+    def meta(self):
+        m = super().meta()
+        m.update({"sensor_offsets_m": self.offsets.tolist(), "sensor_axes": self.axes.tolist(),
+                  "noise_std": float(self.spec.get("noise", 0.0)) * self.f})
+        return m
+
+
 # ------------------------------------------------------------------------------------- machinery
 class ShaftDevice(Device):
     """Base of the per-shaft instruments (spec key 'shaft' in the suite names the shaft)."""
@@ -1079,5 +1286,6 @@ class RudderAngle(Device):
 
 KINDS = {"gnss": GNSS, "range_radar": RangeRadar, "acoustic_range": AcousticRange, "loran": Loran,
          "knotmeter": Knotmeter, "em_log": EMLog, "doppler_log": DopplerLog, "heading": Heading,
-         "attitude": Attitude, "imu": IMU, "wave_probe": WaveProbe, "anemometer": Anemometer, "shaft_torque": ShaftTorque,
+         "attitude": Attitude, "imu": IMU, "wave_probe": WaveProbe, "anemometer": Anemometer,
+         "sonic_anemometer": SonicAnemometer, "accelerometer_array": AccelerometerArray, "shaft_torque": ShaftTorque,
          "shaft_rpm": ShaftSpeed, "thrust": Thrustmeter, "pitch_indicator": PitchIndicator, "rudder": RudderAngle}

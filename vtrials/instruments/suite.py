@@ -197,8 +197,14 @@ class InstrumentSet:
             e, sets, f, where = merged[name]
             self.devices[name] = self._build(e, sets, cat, f, where)
             self.clocks[name] = self._clock(e, cat, f, where)
-            if wind_profile is not None and self.devices[name].kind == "anemometer":
+            if wind_profile is not None and self.devices[name].kind in ("anemometer", "sonic_anemometer"):
                 self.devices[name].profile = (float(wind_profile[0]), float(wind_profile[1]))
+        sonic = [d for d in self.devices.values() if d.kind == "sonic_anemometer"]
+        if sonic:  # the ship's true airwake at their sites (truth: the devices read it, records never carry it)
+            from vtrials.instruments.airwake import load_airwake
+            aw = load_airwake(vessel.folder, vessel.sites)
+            for d in sonic:
+                d.set_airwake(aw, vessel.sites)
         self.seed = seed
         self.stream = tuple(stream)
         self._out: dict[str, list] = {}

@@ -37,14 +37,15 @@ TWO_PI = 2.0 * math.pi
 GAMMA = 3.3  # JONSWAP peak enhancement (Hasselmann et al. 1973 mean)
 
 
-def jonswap(omega, hs: float, tp: float):
-    """JONSWAP S(ω) [m² s/rad], γ = 3.3, σ = 0.07/0.09, scaled on the given grid so ∫S dω = H_s²/16."""
+def jonswap(omega, hs: float, tp: float, gamma: float = GAMMA):
+    """JONSWAP S(ω) [m² s/rad], peak enhancement γ (default 3.3; 1 = Pierson–Moskowitz), σ = 0.07/0.09,
+    scaled on the given grid so ∫S dω = H_s²/16."""
     w = np.asarray(omega, dtype=float)
     wp = TWO_PI / tp
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         pm = np.where(w > 0.0, w ** -5.0 * np.exp(-1.25 * (wp / np.where(w > 0, w, 1.0)) ** 4), 0.0)
     sig = np.where(w <= wp, 0.07, 0.09)
-    S = pm * GAMMA ** np.exp(-((w - wp) ** 2) / (2.0 * sig * sig * wp * wp))
+    S = pm * gamma ** np.exp(-((w - wp) ** 2) / (2.0 * sig * sig * wp * wp))
     m0 = np.trapezoid(S, w)
     return S * (hs * hs / 16.0) / m0
 
@@ -65,6 +66,8 @@ class ShipBuoyFit:
     s: float
     cost: float
     G_pred: np.ndarray
+    gamma: float = GAMMA
+    gains: tuple = ()
 
     def direction_from(self, heading: float) -> float:
         """Nautical direction the waves come FROM [rad], for the ship's heading [rad]."""
@@ -110,9 +113,9 @@ class ResponseModel:
         self._c = np.where(pos, np.conj(Hm) * Hn, Hm * np.conj(Hn))  # (n_pairs, n_cells)
         self.n = n
 
-    def cross_spectra(self, hs: float, tp: float, mu0: float, s: float) -> np.ndarray:
-        """G (n_bins, n_resp, n_resp) [response² s/rad] for the sea (H_s, T_p, μ₀, s)."""
-        S = jonswap(self.omega, hs, tp)
+    def cross_spectra(self, hs: float, tp: float, mu0: float, s: float, gamma: float = GAMMA) -> np.ndarray:
+        """G (n_bins, n_resp, n_resp) [response² s/rad] for the sea (H_s, T_p, μ₀, s; peak enhancement γ)."""
+        S = jonswap(self.omega, hs, tp, gamma)
         D = cos2s(self.mu - mu0, s)
         E = (S[:, None] * D[None, :])[self._ok] * self._cell
         out = np.zeros((self.n * (self.n + 1) // 2, self.omega_e.size), dtype=complex)
@@ -127,11 +130,28 @@ class ResponseModel:
 
 
 def fit_directional_spectrum(model: ResponseModel, G_meas, starts: int = 8, hs0: float = 2.0,
-                             tp0: float = 8.0, s0: float = 5.0) -> ShipBuoyFit:
+                             tp0: float = 8.0, s0: float = 5.0, fit_gamma: bool = False,
+                             free_gain=()) -> ShipBuoyFit:
     """Least-squares fit of (H_s, T_p, μ₀, s) to measured cross-spectra G_meas (n_bins, n, n) on model.omega_e.
 
     ``starts`` starting directions evenly spaced over one turn; bounds T_p ∈ [3, 25] s, s ∈ [0.5, 60].
+    ``fit_gamma``: the peak enhancement γ is a fifth parameter, γ ∈ [1, 7] (1 Pierson–Moskowitz; 7 the
+    upper end of JONSWAP's observed range, Hasselmann et al. 1973), started at 3.3; otherwise γ = 3.3.
+    A ship filters out the short waves of a broad sea (most in head seas at speed): with γ fixed at 3.3
+    a fully developed sea's H_s is under-read (measured on simulator records: benchmarks/shipbuoy_sim.py).
+    ``free_gain``: indices of responses whose RAO is trusted in shape and phase but not in size (e.g. roll
+    of a design-stage model with an assumed damping ratio): each gets a free scale κ ∈ [0.5, 2] on its
+    RAO (G_mn → κ_m κ_n G_mn), so it tells direction and side without setting H_s.
     """
+    free_gain = tuple(int(k) for k in free_gain)
+    nf = len(free_gain)
+    base = 5 if fit_gamma else 4
+
+    def gains(x):
+        g = np.ones(model.n)
+        for j, k in enumerate(free_gain):
+            g[k] = math.exp(x[base + j])
+        return g
     G_meas = np.asarray(G_meas, dtype=complex)
     if G_meas.shape != (model.omega_e.size, model.n, model.n):
         raise InputError("record", "G_meas", f"shape {G_meas.shape}: expected ({model.omega_e.size}, {model.n}, "
@@ -142,19 +162,76 @@ def fit_directional_spectrum(model: ResponseModel, G_meas, starts: int = 8, hs0:
 
     def resid(x):
         hs, tp, s = math.exp(x[0]), math.exp(x[1]), math.exp(x[3])
-        Gp = model.cross_spectra(hs, tp, x[2], s)
+        Gp = model.cross_spectra(hs, tp, x[2], s, math.exp(x[4]) if fit_gamma else GAMMA)
+        if nf:
+            g = gains(x)
+            Gp = Gp * (g[:, None] * g[None, :])[None]
         d = (Gp[:, i, j] - G_meas[:, i, j]) / sigma[None, :]
         return np.concatenate([d.real.ravel(), d.imag.ravel()])
 
-    lo = [math.log(0.05), math.log(3.0), -np.inf, math.log(0.5)]
-    hi = [math.log(20.0), math.log(25.0), np.inf, math.log(60.0)]
+    lo = [math.log(0.05), math.log(3.0), -np.inf, math.log(0.5)] + ([0.0] if fit_gamma else [])
+    hi = [math.log(20.0), math.log(25.0), np.inf, math.log(60.0)] + ([math.log(7.0)] if fit_gamma else [])
+    scale = [0.3, 0.2, 0.5, 0.5] + ([0.5] if fit_gamma else [])
+    lo += [math.log(0.5)] * nf
+    hi += [math.log(2.0)] * nf
+    scale += [0.3] * nf
     best = None
     for k in range(starts):
         x0 = [math.log(hs0), math.log(tp0), -math.pi + TWO_PI * (k + 0.5) / starts, math.log(s0)]
-        r = optimize.least_squares(resid, x0, bounds=(lo, hi), x_scale=[0.3, 0.2, 0.5, 0.5], max_nfev=200)
+        x0 += ([math.log(GAMMA)] if fit_gamma else []) + [0.0] * nf
+        r = optimize.least_squares(resid, x0, bounds=(lo, hi), x_scale=scale, max_nfev=200)
         if best is None or r.cost < best.cost:
             best = r
     x = best.x
     hs, tp, s = math.exp(x[0]), math.exp(x[1]), math.exp(x[3])
+    gamma = math.exp(x[4]) if fit_gamma else GAMMA
     mu0 = math.remainder(x[2], TWO_PI)
-    return ShipBuoyFit(hs, tp, mu0, s, float(best.cost), model.cross_spectra(hs, tp, mu0, s))
+    g = gains(x)
+    Gp = model.cross_spectra(hs, tp, mu0, s, gamma) * (g[:, None] * g[None, :])[None]
+    return ShipBuoyFit(hs, tp, mu0, s, float(best.cost), Gp, gamma, tuple(float(v) for v in g))
+
+
+@dataclasses.dataclass(frozen=True)
+class RecordBuoy:
+    """Ship-as-a-wave-buoy result of one run: the fit, the ship's mean heading and speed, the components."""
+
+    fit: ShipBuoyFit
+    heading: float
+    U: float
+    components: tuple
+    duration_s: float
+
+    @property
+    def from_relative_deg(self) -> float:
+        """Where the waves come FROM relative to the bow [deg], + starboard, − port, in (−180, 180]."""
+        return math.degrees(math.remainder(self.fit.mu0 + math.pi, TWO_PI))
+
+
+def ship_buoy_from_record(record, t0: float, t1: float, design, components=("heave", "roll", "pitch"),
+                          seg_s: float = 128.0, band=(0.2, 2.0), fs: float = 2.0, starts: int = 8,
+                          fit_gamma: bool = True, free_gain=()) -> RecordBuoy:
+    """Fit the directional sea to a run's measured motions (records only) with the team's design RAOs.
+
+    Motions by :func:`vtrials.reduce.seamotion.run_motions` between t0 and t1 [s]; cross-spectra by Welch
+    with segments of ``seg_s`` [s]; encounter-frequency ``band`` [rad/s]; the RAOs of ``design`` (a
+    :class:`vtrials.reduce.design_rao.DesignRAO`) at the run's mean log speed on a 0.2–2.5 rad/s × 5° grid.
+    γ is fitted (``fit_gamma``) and every RAO trusted in size by default (``free_gain`` names components
+    given a free scale): on simulator records (benchmarks/shipbuoy_sim.py, 16 runs) a free roll gain gave
+    no better H_s and worse directions.
+    """
+    from vtrials.reduce.seamotion import design_responses, run_motions
+    from vtrials.reduce.spectra import cross_spectral_matrix
+
+    mot = run_motions(record, t0, t1, fs_out=fs)
+    rec = mot.series(components)
+    G_ = cross_spectral_matrix(rec, mot.fs, int(round(seg_s * mot.fs)))
+    keep = (G_.omega >= band[0]) & (G_.omega <= band[1])
+    omega = np.linspace(0.2, 2.5, 200)
+    mu = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+    W, M = np.meshgrid(omega, mu, indexing="ij")
+    model = ResponseModel(omega, mu, design_responses(design, components, W, M, mot.U, mot.site), mot.U,
+                          G_.omega[keep])
+    hs0 = 4.0 * float(np.std(mot.heave)) if "heave" in components else 2.0
+    fit = fit_directional_spectrum(model, G_.S[keep], starts=starts, hs0=max(hs0, 0.2), fit_gamma=fit_gamma,
+                                   free_gain=[components.index(c) for c in free_gain if c in components])
+    return RecordBuoy(fit, mot.heading, mot.U, tuple(components), float(mot.t[-1] - mot.t[0]))

@@ -627,6 +627,9 @@ def reduce_record(rec: Record) -> dict:
     if kind == "maneuvering":
         from vtrials.reduce.maneuvering import reduce_maneuvering
         return reduce_maneuvering(rec)
+    if kind == "airwake_survey":
+        from vtrials.reduce.airwake_survey import reduce_airwake_survey
+        return reduce_airwake_survey(rec)
     if kind == "seakeeping":
         from vtrials.reduce.seakeeping import reduce_seakeeping
         return reduce_seakeeping(rec)

@@ -14,6 +14,12 @@ mean of r_i over the chosen components (eq. 5), H_s = r H_s,radar (eq. 1) and S�
 The RAOs are an INPUT: the design-stage model the trials team has (seed 004 used the strip-theory code
 ShipMo7), never the simulator's truth. Angles μ are the wave propagation direction relative to the
 ship's heading (0 following, π head seas) on a uniform grid over one turn.
+
+From a trial record, :func:`fuse_run` does the whole thing for one run: the radar's mean directional
+spectrum over the run (turned into the ship's frame with the gyro heading), the design-stage RAOs
+(:mod:`vtrials.reduce.design_rao`) at the run's mean log speed, the measured RMS of heave (IMU, double
+integrated), pitch, roll and vertical acceleration (:mod:`vtrials.reduce.seamotion`). Measured on
+simulator records: benchmarks/campaign_wavefusion.py (results in benchmarks/results/).
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import math
 import numpy as np
 
 from vtrials.errors import InputError
+from vtrials.units import G
 
 TWO_PI = 2.0 * math.pi
 
@@ -69,3 +76,73 @@ def fuse(hs_radar: float, S_radar, measured_rms, predicted_rms_values) -> Fusion
     ratios = meas / pred
     r = float(np.mean(ratios))
     return Fusion(ratios, r, r * float(hs_radar), r * r * np.asarray(S_radar, dtype=float))
+
+
+# ------------------------------------------------------------------------------------------ from records
+
+COMPONENTS = ("heave", "pitch", "roll", "acc")
+
+
+@dataclasses.dataclass(frozen=True)
+class RunFusion:
+    """Wave fusion of one run: the radar's H_s (mean over the run's spectra), each component's measured and
+    predicted RMS, and the fused H_s for every requested combination of components."""
+
+    hs_radar: float
+    n_spectra: int
+    measured: dict
+    predicted: dict
+    fused: dict          # {"heave+pitch": Fusion, ...}
+    U: float
+    heading: float
+    heading_std: float = 0.0
+
+
+def radar_window(record, t0: float, t1: float, radar: str = "radar"):
+    """(ω [rad/s], directions towards [rad], mean S(ω, μ) [m² s/rad²], mean H_s [m], n) of the radar's
+    spectra stamped inside [t0, t1] (each is stamped at the end of its acquisition)."""
+    if radar not in record.instruments:
+        raise InputError(str(getattr(record, "path", "record")), radar, "no wave radar in the record")
+    t, spec = record.channel(radar, "spectrum")
+    hs = record.channel(radar, "hs")[1]
+    m = record.meta(radar)
+    k = (t >= t0) & (t <= t1) & np.isfinite(hs)
+    if not np.any(k):
+        raise InputError(str(getattr(record, "path", "record")), radar, f"no radar spectrum between {t0:.0f} and {t1:.0f} s")
+    S = np.asarray(spec)[k]
+    return (np.asarray(m["omega_rad_s"], float), np.asarray(m["directions_to_rad"], float), S.mean(axis=0),
+            float(np.mean(hs[k])), int(np.count_nonzero(k)))
+
+
+def fuse_run(record, t0: float, t1: float, design, combos=(("heave", "pitch"),), radar: str = "radar",
+             omega_c: float = 0.25, fs: float = 2.0) -> RunFusion:
+    """Seed 004's fusion for one run from its record (module doc): the radar's mean directional spectrum
+    over the run, turned into the ship's frame with the gyro heading, predicts each motion component's RMS
+    through the team's design RAOs (``design``, :class:`vtrials.reduce.design_rao.DesignRAO`) at the run's
+    mean log speed; the record gives the measured RMS (:func:`vtrials.reduce.seamotion.run_motions`).
+    The heave prediction carries the same high-pass (``omega_c`` on the encounter frequency, half-cosine
+    from ω_c/2) as the double integration that measures it. ``combos``: tuples of 'heave', 'pitch', 'roll',
+    'acc' (vertical acceleration at the IMU) fused together (r = mean of their ratios)."""
+    from vtrials.reduce.seamotion import design_responses, run_motions
+
+    bad = sorted({c for combo in combos for c in combo} - set(COMPONENTS))
+    if bad or not combos or any(len(c) == 0 for c in combos):
+        raise InputError("record", "combos", f"{bad or list(combos)}: each combination is a non-empty tuple of "
+                         f"motion components; allowed heave, roll, pitch, acc")
+    mot = run_motions(record, t0, t1, fs_out=fs, omega_c=omega_c)
+    w, mu_to, S, hs_r, n = radar_window(record, t0, t1, radar)
+    mu_rel = mu_to - mot.heading
+    W, M = np.meshgrid(w, mu_rel, indexing="ij")
+    names = sorted({c for combo in combos for c in combo}, key=COMPONENTS.index)
+    H = design_responses(design, names, W, M, mot.U, mot.site)
+    we = np.abs(W - W * W * mot.U * np.cos(M) / G)
+    taper = np.clip((we - 0.5 * omega_c) / (0.5 * omega_c), 0.0, 1.0)
+    taper = 0.5 - 0.5 * np.cos(math.pi * taper)
+    meas, pred = {}, {}
+    ser = mot.series(names)
+    for i, c in enumerate(names):
+        h = H[i] * taper if c == "heave" else H[i]
+        pred[c] = predicted_rms(w, mu_rel, S, h)
+        meas[c] = float(np.std(ser[i]))
+    fused = {"+".join(combo): fuse(hs_r, S, [meas[c] for c in combo], [pred[c] for c in combo]) for combo in combos}
+    return RunFusion(hs_r, n, meas, pred, fused, mot.U, mot.heading, mot.heading_std)

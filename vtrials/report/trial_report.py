@@ -399,6 +399,40 @@ def _mv_markdown(tr: dict, figs: list[str]) -> list[str]:
     return L
 
 
+def _pc(x) -> str:
+    return "n/a" if x is None else f"{100 * x:.1f} %"
+
+
+def _aw_markdown(tr: dict) -> list[str]:
+    """Airwake survey: per recording the relative wind, the airwake ratio (mast / reference) against
+    truth, the true motion-induced velocity and what AWSM left of it, and the mean change."""
+    s = tr["error"]["summary"]
+    L = [f"## {tr['name']} (airwake survey)", "",
+         f"Motion-induced velocity left after AWSM (max over recordings): {_pc(s['max_residual_fraction_awsm'])} "
+         f"(the seed's order, body-axis mean removed then rotated: "
+         f"{_pc(s['max_residual_fraction_awsm_seed_order'])}); acceptance < 10 %: {s['residual_accepted']}. "
+         f"Mean airwake unchanged by the correction within its 95 % interval: {s['mean_unchanged_all']} "
+         f"(largest change {s['max_abs_mean_change']:.3f} m/s; indistinguishable from zero by its own interval in "
+         f"{_pc(s['mean_change_indistinguishable_from_zero'])} of the components). "
+         f"Coverage of the 95 % intervals (mean components, ratios): {_pc(s['coverage'])}.", "",
+         "| run | position | wind ordered | ratio K (95 %) | true K | motion-induced RMS [m/s] | left by AWSM | "
+         "mean change u, v, w [m/s] |", "|---|---|---|---|---|---|---|---|"]
+    red = {r["run"]: r for r in tr["reduced"]["runs"]}
+    for e in tr["error"]["runs"]:
+        r = red.get(e["run"], {})
+        if "reduction_error" in e or "airwake_ratio" not in e:
+            L.append(f"| {e['run']} | {e['position']} | | {e.get('reduction_error', '')} | | | | |")
+            continue
+        k = r["airwake_ratio"]["speed_ratio"]
+        w = r["relative_wind_speed_ordered"]
+        wind = f"{math.degrees(r['relative_wind_ordered']):.0f}°" + ("" if w is None else f" {w / KNOT:.0f} kn")
+        ch = ", ".join(f"{c['change']:+.3f}" for c in e["mean_change"])
+        L.append(f"| {e['run']} | {e['position']} | {wind} | {k['value']:.3f} ({k['lo95']:.3f}–{k['hi95']:.3f}) | "
+                 f"{e['airwake_ratio']['truth']:.3f} | {e['true_motion_induced_rms']:.2f} | "
+                 f"{_pc(e['residual_fraction_awsm'])} | {ch} |")
+    return L + [""]
+
+
 def imo_rows(verdicts: dict, truth: dict) -> list[str]:
     """Markdown rows of the IMO verdict table; angles (kept in rad inside) are printed in degrees,
     the unit the MSC.137(76) criteria are written in, and every value carries its unit."""
@@ -461,5 +495,7 @@ def write_report(doc: dict, res, out: Path) -> None:
         elif tr["kind"] == "seakeeping":
             from vtrials.report import seakeeping_report as SKR
             L += SKR.markdown(tr, SKR.figures(tr, out))
+        elif tr["kind"] == "airwake_survey":
+            L += _aw_markdown(tr)
     with atomic_path(out / "report.md") as tmp:
         tmp.write_text("\n".join(L) + "\n")

@@ -217,7 +217,7 @@ def score_seakeeping(reduced: dict, res, name: str) -> dict:
     scn = res.scenario
     truth = _truth_of(res.crew, name)
     comp = np.asarray(res.seaway, float)
-    model = _ShipModel(scn, res.hydro_path)
+    model = _ShipModel(scn, res.hydro_path) if reduced.get("legs") else None
     iset = res.crew.iset
     probe = [d for d in iset.devices.values() if d.kind == "wave_probe"]
     imu = [d for d in iset.devices.values() if d.kind == "imu"]

@@ -388,6 +388,9 @@ def score_trial(kind: str, reduced: dict, res, name: str) -> dict:
         return score_log_calibration(reduced, res, name)
     if kind == "maneuvering":
         return score_maneuvering(reduced, res, name)
+    if kind == "airwake_survey":
+        from vtrials.score.airwake import score_airwake_survey
+        return score_airwake_survey(reduced, res, name)
     if kind == "seakeeping":
         from vtrials.score.seakeeping import score_seakeeping
         return score_seakeeping(reduced, res, name)

@@ -12,6 +12,11 @@ one after another on one ship:
 ``[[agenda.trial]] kind = "log_calibration"``
     ``[[agenda.trial.speed]]``: constant r/min legs, ``pattern`` = ``four_leg`` (four headings 90°
     apart, seed 000) or ``pair`` (a reciprocal pair).
+``[[agenda.trial]] kind = "airwake_survey"``
+    ``[[agenda.trial.condition]]``: a relative wind over deck to hold (``relative_wind_deg`` off the
+    bow, ``relative_wind_kn``, or a fixed shaft setting whose speed the wind then gives), and the
+    ``positions`` (deck sockets, ``models/<ship>/airwake.toml`` ``[mast]``) the mobile anemometer mast
+    is moved among: one recording of ``record_s`` per position (seed 003: 13 positions, 90 s each).
 ``[[agenda.trial]] kind = "seakeeping"``
     ``[[agenda.trial.leg]]``: the star pattern of a seakeeping trial (seed 004 Table 1): one leg per
     table, its heading named relative to the mean wave direction the team observes (``head``,
@@ -32,7 +37,7 @@ import math
 from vtrials.errors import InputError
 from vtrials.schema import (did_you_mean, check_name, choice, flag, integer, num, read_table, table, table_list, text, unknown_key,
                             vector)
-from vtrials.units import DEG, RPM
+from vtrials.units import DEG, KNOT, RPM
 
 ORDERS = ("ahead_1_3", "ahead_2_3", "standard", "full", "flank")
 ALL_ORDERS = ORDERS + ("stop", "back_1_3", "back_2_3", "back_full", "back_emergency")
@@ -93,7 +98,8 @@ class AgendaRules:
 @dataclasses.dataclass(frozen=True)
 class TrialHead:
     name: str = text("name of the trial (its record file is records/<name>.nc)")
-    kind: str = text("kind of trial", ("standardization", "log_calibration", "maneuvering", "seakeeping"))
+    kind: str = text("kind of trial", ("standardization", "log_calibration", "maneuvering", "airwake_survey",
+                                       "seakeeping"))
     run_s: float = num("length of each measured run (EXECUTE to FINEX)", "s", 10.0, 7200.0, default=180.0)
     autopilot_rudder_deg: float = num("override of the agenda's helm rudder limit for this trial", "deg",
                                       0.0, 35.0, lo_open=True, default=None)
@@ -167,6 +173,26 @@ class ManeuverSpec(Setting):
                                 "EXECUTE", "s", 10.0, 1e5, default=None)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class AirwakeCondition(Setting):
+    """One wind-over-deck condition of an airwake survey (seed 003: the officer of the watch holds a
+    nominally constant relative wind while the mobile mast is moved among the deck positions).
+    ``positions`` (a list of deck-socket site names) is read separately (the schema has no string lists)."""
+
+    relative_wind_deg: float = num("relative wind to hold: the direction it comes from, off the bow, + to "
+                                   "starboard (seed 003: 0-180)", "deg", -180.0, 360.0)
+    relative_wind_kn: float = num("relative wind speed to hold (seed 003: 10-30 kn); the crew sets course and "
+                                  "speed for it from the reference anemometer. Omit it to keep a given shaft "
+                                  "setting (order or rpm) and set the course only", "kn", 0.0, 80.0, lo_open=True,
+                                  default=None)
+    record_s: float = num("recording at each mast position (seed 003: 90 s; 60 s at full speed)", "s", 10.0, 600.0,
+                          default=90.0)
+    move_s: float = num("time to unstep the mast and step it in the next socket (data not used)", "s", 0.0, 3600.0,
+                        default=60.0)
+    wind_tolerance_deg: float = num("relative wind direction the crew accepts as on the ordered one", "deg", 0.0,
+                                    45.0, lo_open=True, default=5.0)
+    wind_tolerance_kn: float = num("relative wind speed the crew accepts as on the ordered one", "kn", 0.0, 20.0,
+                                   lo_open=True, default=1.5)
 # angle off the bow [deg] from which the waves come on each named seakeeping leg (+ starboard);
 # the ordered course is the observed mean wave direction (from) minus this angle
 WAVE_RELATIVE_DEG = {"head": 0.0, "bow_starboard": 45.0, "beam_starboard": 90.0, "quarter_starboard": 135.0,
@@ -224,7 +250,8 @@ class Agenda:
 
 
 _ITEMS = {"standardization": ("spot", SpotSpec), "log_calibration": ("speed", SpeedSpec),
-          "maneuvering": ("run", ManeuverSpec), "seakeeping": ("leg", SeakeepingLeg)}
+          "maneuvering": ("run", ManeuverSpec), "airwake_survey": ("condition", AirwakeCondition),
+          "seakeeping": ("leg", SeakeepingLeg)}
 
 
 def _setting(s: Setting, vessel, f: str, sec: str) -> tuple[float, float | None, tuple, str | None]:
@@ -325,6 +352,12 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
             raise InputError(f, f"{sec}.{item_key}", f"expected at least one [[agenda.trial.{item_key}]] table")
         table_list(items, f, f"{sec}.{item_key}")
         runs = []
+        if kind == "airwake_survey":
+            for ii, itab in enumerate(items):
+                runs += _airwake_runs(itab, number, head.name, ii, base, limit, vessel, f, f"{sec}.{item_key}[{ii}]")
+                number = runs[-1].number
+            trials.append(Trial(head, runs))
+            continue
         for ii, itab in enumerate(items):
             isec = f"{sec}.{item_key}[{ii}]"
             spec, _ = read_table(item_cls, itab, f, isec)
@@ -374,6 +407,57 @@ def load_agenda(doc: dict, vessel, f: str) -> Agenda:
                                 ii + 1, k + 1, f"{what} {ii + 1} run {k + 1}", order))
         trials.append(Trial(head, runs))
     return Agenda(rules, steadiness, trials)
+
+
+def _airwake_runs(itab: dict, number: int, trial: str, index: int, base: float, limit: float, vessel, f: str,
+                  sec: str) -> list[Run]:
+    """One run per mast position of an airwake-survey condition (SI)."""
+    from vtrials.instruments.airwake import load_airwake
+    if not isinstance(itab, dict):
+        raise InputError(f, sec, "expected a table")
+    itab = dict(itab)
+    positions = itab.pop("positions", None)
+    spec, _ = read_table(AirwakeCondition, itab, f, sec)
+    aw = load_airwake(vessel.folder, vessel.sites)
+    sockets = list(aw.mast_positions) if aw is not None else []
+    if not sockets:
+        raise InputError(f, f"{sec}.positions", f"{vessel.name} has no mobile-mast positions (models/"
+                                                f"{vessel.name}/airwake.toml [mast] positions)")
+    if not isinstance(positions, list) or not positions or not all(isinstance(x, str) for x in positions):
+        raise InputError(f, f"{sec}.positions", f"expected a non-empty list of deck positions (allowed: "
+                                                f"{', '.join(sockets)}), got {positions!r}"[:300])
+    for k, x in enumerate(positions):
+        if x not in sockets:
+            raise InputError(f, f"{sec}.positions[{k}]", f"{x!r} is not a mast position of {vessel.name}"
+                                                         f"{did_you_mean(x, sockets)} (allowed: {', '.join(sockets)})")
+    if len(set(positions)) != len(positions):
+        raise InputError(f, f"{sec}.positions", "a position is listed twice")
+    given = spec.order is not None or spec.rpm is not None
+    if given == (spec.relative_wind_kn is not None):
+        raise InputError(f, f"{sec}.relative_wind_kn", "give either relative_wind_kn (the crew sets the speed) or a "
+                                                       "shaft setting (order, or rpm and pitch), not both")
+    if given:
+        rps, pitch, modes, order = _setting(spec, vessel, f, sec)
+        if order is not None and order not in ORDERS:
+            raise InputError(f, f"{sec}.order", f"an airwake survey needs an ahead order ({', '.join(ORDERS)})")
+    else:  # a starting setting; the crew adjusts the speed for the ordered relative wind
+        order = next((o for o in ORDERS if o in vessel.telegraph), None)
+        if order is None:
+            raise InputError(f, f"{sec}.relative_wind_kn", f"{vessel.name} has no ahead telegraph order to set "
+                                                           f"speeds from; give rpm instead")
+        rps, pitch = vessel.telegraph[order]
+        modes = ("governed",) * len(vessel.shafts)
+    gamma = ((spec.relative_wind_deg + 180.0) % 360.0) - 180.0
+    params = {"relative_wind": gamma * DEG, "relative_wind_speed": None if spec.relative_wind_kn is None
+              else spec.relative_wind_kn * KNOT, "move_s": spec.move_s, "hold_speed": not given,
+              "wind_tolerance": spec.wind_tolerance_deg * DEG, "wind_speed_tolerance": spec.wind_tolerance_kn * KNOT}
+    runs = []
+    for k, pos in enumerate(positions):
+        wind = f"{gamma:g}°" + ("" if spec.relative_wind_kn is None else f"/{spec.relative_wind_kn:g} kn")
+        runs.append(Run(number + k + 1, trial, "airwake", base * DEG, rps, pitch, tuple(modes), spec.record_s,
+                        limit * DEG, index + 1, k + 1, f"wind {wind} at {pos}"[:40], order if given else None,
+                        {**params, "position": pos}))
+    return runs
 
 
 def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pitch, modes, order, base: float,

@@ -541,6 +541,9 @@ class Crew:
 
     # ------------------------------------------------------------------ runs
     def execute(self, run: Run, attempt: int) -> Attempt:
+        if run.kind == "airwake":
+            from vtrials.trials import airwake_survey
+            return airwake_survey.execute(self, run, attempt)
         if run.kind == "seakeeping":
             return self.execute_seakeeping(run, attempt)
         if run.kind != "speed":

@@ -1,0 +1,100 @@
+"""The trials team's design-stage RAO model of patrol51 (models/patrol51/design): what it is, and that it is
+NOT the simulator's truth — different as a real design-stage model would be, and not wildly so.
+
+Truth here: the held-DOF frequency-domain RAO of the simulator's own model (truth database at its finest
+mesh, ship.toml restoring and mass, the linear viscous roll damping of hull.toml, the time domain's speed
+term; :func:`vtrials.physics.seakeeping.rao.rao`, which tests/test_seakeeping_irregular.py holds within
+10 % of the simulated ship in head seas). The coupled truth with the maneuvering model and the autopilot
+(:mod:`vtrials.truth.motion_rao`) is compared in benchmarks/design_rao_vs_truth.py (README beside the file).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from vtrials.errors import InputError
+from vtrials.physics.environment.waves import peak_frequency, spectrum
+from vtrials.physics.seakeeping import rao as rao_mod
+from vtrials.physics.seakeeping.database import load_database
+from vtrials.physics.seakeeping.timedomain import roll_damping_of
+from vtrials.physics.vessel import load_vessel, model_dir
+from vtrials.reduce.design_rao import DesignRAO, load_design_rao
+from vtrials.units import G
+
+
+@pytest.fixture(scope="module")
+def design():
+    return load_design_rao("patrol51")
+
+
+def test_design_file_states_how_it_differs(design):
+    truth = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
+    a = design.attrs
+    assert "NOT the simulator's truth" in a["content"]
+    assert a["mesh_panels_half_hull"] < json.loads(truth.attrs["convergence"])["levels"][-1]["panels_half"] / 3
+    doc = json.loads(a["design_toml"])
+    assert doc["condition"]["KG"]["value"] != 3.36                  # design KG, not the as-inclined one
+    assert abs(float(a["GM_T"]) - 1.1) > 0.1                          # so its GM_T is not the simulator's
+    assert doc["model"]["roll_damping_ratio"]["value"] == pytest.approx(float(a["roll_damping_ratio"]))
+    for sec in ("design", "condition", "model"):                      # every parameter names its source
+        for k, v in doc[sec].items():
+            if isinstance(v, dict):
+                assert v.get("source"), (sec, k)
+
+
+def test_long_wave_limits_and_symmetry(design):
+    """Independent limits: in long waves the ship follows the surface (heave → 1 m/m, pitch → the wave
+    slope k in head seas); heave and pitch are symmetric port/starboard, roll antisymmetric."""
+    w = np.array([0.2])
+    R = design.rao(w, math.pi, 0.0)[:, 0]
+    assert abs(R[0]) == pytest.approx(1.0, abs=0.01)
+    assert abs(R[2]) == pytest.approx(w[0] ** 2 / G, rel=0.05)
+    ww = np.linspace(0.3, 2.0, 30)
+    for mu in (0.4, 1.2, 2.5):
+        a, b = design.rao(ww, mu, 4.0), design.rao(ww, -mu, 4.0)
+        np.testing.assert_allclose(a[0], b[0], rtol=1e-12)
+        np.testing.assert_allclose(a[2], b[2], rtol=1e-12)
+        np.testing.assert_allclose(a[1], -b[1], rtol=1e-12)
+    # a point forward of O on the centreline heaves with z − xθ (down): vertical() at x = 0 is −heave
+    np.testing.assert_allclose(design.vertical(R[:, None], 0.0)[0], -R[0])
+
+
+def test_design_differs_from_truth_but_not_wildly(design):
+    """RMS response in a long-crested JONSWAP sea (H_s 2 m, T_p 8 s) at 5 m/s, design vs truth. Measured:
+    head seas heave +23 %, pitch −6 %; 135°: heave +18 %, roll −11 %, pitch −9 %; beam: heave +4 %, roll
+    −26 % (pitch in beam seas, −40 %, is a few per cent of its head-sea value). Neither identical
+    (some component ≥ 5 % off at each heading) nor wildly off (heave and pitch within 30 % where they
+    matter, roll within 35 %)."""
+    ves = load_vessel("patrol51")
+    db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
+    U = 5.0
+    bv = np.zeros((6, 6))
+    bv[3, 3] = float(roll_damping_of(ves, db).B1(U))
+    kw = dict(M=ves.M_RB, C=ves.restoring_matrix(), B_visc=bv, body_axes_added_mass=True)
+    w = np.linspace(0.25, 2.5, 400)
+    S = spectrum("jonswap", w, 2.0, peak_frequency("jonswap", 3.3, tp=8.0), 3.3)
+    diffs = {}
+    for hd in (180, 135, 90):
+        b = math.radians(hd)
+        T = rao_mod.rao(db, w, b, U, (2, 3, 4), **kw)[:, 2:5].T
+        D = design.rao(w, b, U)
+        diffs[hd] = [math.sqrt(np.trapezoid(np.abs(D[k]) ** 2 * S, w) / np.trapezoid(np.abs(T[k]) ** 2 * S, w)) - 1.0
+                     for k in range(3)]
+        print(hd, "heave, roll, pitch RMS design/truth − 1:", np.round(diffs[hd], 3))
+    for hd, (dh, dr, dp) in diffs.items():
+        relevant = [dh] + ([dr] if hd != 180 else []) + ([dp] if hd != 90 else [])
+        assert max(abs(x) for x in relevant) >= 0.05, hd            # not the truth
+        assert abs(dh) <= 0.30, hd
+        if hd != 90:
+            assert abs(dp) <= 0.30, hd
+        if hd != 180:
+            assert abs(dr) <= 0.35, hd
+
+
+def test_missing_file_is_named(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        DesignRAO(tmp_path / "nothing.nc")
