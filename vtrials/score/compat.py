@@ -1,0 +1,126 @@
+"""Scoring Compat (:mod:`vtrials.reduce.compat_records`) against truth: the IMU's effective biases over
+the fit window and the true motion of the centre of motion.
+
+Reference "true bias" (what a constant-bias model can estimate): for each IMU channel the window mean of
+everything the instrument added to its true measurand,
+
+    b_true = mean over the fit's IMU samples of (recorded − true measurand at the IMU site),
+
+with the true measurand (specific force including the lever-arm terms, body rates) computed from the
+truth file by :class:`vtrials.instruments.kinematics.SiteKinematics` and interpolated linearly to the
+recorded time stamps exactly as the IMU's own sampling does (:class:`vtrials.instruments.parts.Resample`).
+This is the drawn turn-on bias plus the window means of the bias instability (Gauss–Markov) and bias
+random walk, plus misalignment and scale factor acting on the window-mean measurand (for the horizontal
+accelerometers mostly the misalignment's gravity leak g·δ), plus the window mean of the white noise
+(σ/√N: 4·10⁻⁵ m/s² and 2·10⁻⁶ rad/s for the tactical IMU over 90 s, two orders below the bounds). The
+parts that vary within the window about that mean (misalignment × wave motion, the slow wander) are
+what the fit leaves in its residuals. The invariant combinations' references use the true mean roll and
+pitch of the window.
+
+True states: roll, pitch (Euler angles of the hull frame), the body velocities through the water
+(u_r, v_r, w_r: with a log and v ≈ 0 the fit reconstructs water-relative velocities; with GNSS aiding
+over-ground ones, u, v, w) and the heave velocity (earth-down velocity of the reference point), at the
+recorded IMU time stamps.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vtrials.instruments.kinematics import SiteKinematics, rotation_matrices
+from vtrials.units import G
+
+IMU_CHANNELS = (("b_ax", "ax"), ("b_ay", "ay"), ("b_az", "az"), ("b_p", "p"), ("b_q", "q"), ("b_r", "r"))
+_COLS = ("x", "y", "z", "qw", "qx", "qy", "qz", "roll", "pitch", "heading", "u", "v", "w", "p", "q", "r",
+         "u_r", "v_r", "w_r", "du", "dv", "dw", "dp", "dq", "dr", "current_n", "current_e")
+
+
+def truth_columns(truth_vars: dict, t_truth: np.ndarray) -> dict:
+    """The truth columns the scoring needs, from the truth file's variables."""
+    cols = {k: np.asarray(truth_vars[k], float) for k in _COLS}
+    cols["t"] = np.asarray(t_truth, float)
+    return cols
+
+
+def _interp(t_out: np.ndarray, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    if y.ndim == 1:
+        return np.interp(t_out, t, y)
+    return np.column_stack([np.interp(t_out, t, y[:, k]) for k in range(y.shape[1])])
+
+
+def true_imu(cols: dict, site, t_rec: np.ndarray) -> dict:
+    """True measurand of an IMU at ``site`` at the recorded time stamps: channel → array."""
+    kin = SiteKinematics(cols, np.asarray(site, float))
+    sf = _interp(t_rec, cols["t"], kin.specific_force())
+    om = _interp(t_rec, cols["t"], kin.omega)
+    return {"ax": sf[:, 0], "ay": sf[:, 1], "az": sf[:, 2], "p": om[:, 0], "q": om[:, 1], "r": om[:, 2]}
+
+
+def true_biases(record, cols: dict, t0: float, t1: float, imu: str = "imu") -> dict:
+    """Effective bias of each IMU channel over [t0, t1] (module note): name → value [SI]."""
+    t_rec, _ = record.channel(imu, "p")
+    sel = (t_rec >= t0) & (t_rec <= t1)
+    site = record.meta(imu)["surveyed_position_m"]  # the surveyed position is the true site here
+    tru = true_imu(cols, site, t_rec[sel])
+    return {b: float(np.mean(record.channel(imu, ch)[1][sel] - tru[ch])) for b, ch in IMU_CHANNELS}
+
+
+def true_states(cols: dict, t: np.ndarray) -> dict:
+    """True roll, pitch, heading, body velocities (through the water and over ground) and the heave
+    velocity (earth-down velocity of the reference point) at times t."""
+    out = {k: np.interp(t, cols["t"], cols[k]) for k in ("roll", "pitch", "u", "v", "w", "u_r", "v_r", "w_r")}
+    out["heading"] = np.interp(t, cols["t"], np.unwrap(cols["heading"]))
+    R = rotation_matrices(cols["qw"], cols["qx"], cols["qy"], cols["qz"])
+    v_down = np.einsum("nj,nj->n", R[:, 2, :], np.column_stack([cols["u"], cols["v"], cols["w"]]))
+    out["v_down"] = np.interp(t, cols["t"], v_down)
+    return out
+
+
+def true_invariants(biases: dict, states: dict, gravity: float = G) -> dict:
+    """Reference invariant combinations with the true window-mean attitude."""
+    phi, th = float(np.mean(states["roll"])), float(np.mean(states["pitch"]))
+    return {"x": biases["b_ax"] + gravity * math.cos(th) * th,
+            "y": biases["b_ay"] - gravity * math.cos(th) * math.cos(phi) * phi}
+
+
+def _covers(e: dict, x: float) -> bool:
+    return bool(e["lo95"] <= x <= e["hi95"])
+
+
+def score_stage(stage: dict, biases: dict, cols: dict, over_ground: bool = False) -> dict:
+    """Errors, coverage and reconstruction RMS errors of one stage's result."""
+    t = np.asarray(stage["states"]["time"], float)
+    tru = true_states(cols, t)
+    est = stage["estimates"]
+    out = {"biases": {}, "invariants": {}, "state_rms": {}}
+    for b in biases:
+        if b in est:
+            e = est[b]
+            out["biases"][b] = {"value": e["value"], "std": e["std"], "dof": e["dof"], "truth": biases[b],
+                                "error": e["value"] - biases[b], "covered": _covers(e, biases[b])}
+    inv_true = true_invariants(biases, tru)
+    for k, e in stage.get("invariants", {}).items():
+        out["invariants"][k] = {"value": e["value"], "std": e["std"], "dof": e["dof"], "truth": inv_true[k],
+                                "error": e["value"] - inv_true[k], "covered": _covers(e, inv_true[k])}
+    s = stage["states"]
+    vel = ("u", "v", "w") if over_ground else ("u_r", "v_r", "w_r")
+    pairs = {"roll": "roll", "pitch": "pitch", "u": vel[0], "v": vel[1], "w": vel[2], "v_down": "v_down"}
+    for k, ref in pairs.items():
+        d = np.asarray(s[k], float) - tru[ref]
+        out["state_rms"][k] = float(np.sqrt(np.mean(d ** 2)))
+        out["state_rms"][f"{k}_detrended"] = float(np.std(d - np.polyval(np.polyfit(t - t[0], d, 1), t - t[0])))
+        out["state_rms"][f"{k}_true_rms"] = float(np.std(tru[ref]))
+    return out
+
+
+def score_compat(reduced: dict, record, cols: dict, imu: str = "imu", over_ground: bool = False) -> dict:
+    """Score every stage of :func:`vtrials.reduce.compat_records.reduce_compat`'s output."""
+    t0, t1 = reduced["window"]
+    b = true_biases(record, cols, t0, t1, imu)
+    out = {"true_biases": b}
+    for st in ("one_stage", "two_stage"):
+        if st in reduced:
+            out[st] = score_stage(reduced[st], b, cols, over_ground)
+    return out
