@@ -69,7 +69,7 @@ def replicate(args: tuple) -> dict:
     from vtrials.reduce.compat_records import reduce_compat, run_window
     from vtrials.runner.trial_day import simulate_agenda, write_agenda_truth, write_trial_records
     from vtrials.scenario import load_scenario
-    from vtrials.score.compat import score_compat, truth_columns
+    from vtrials.score.compat import imu_clock, score_compat as _score, truth_columns
     t_start = time.perf_counter()
     scn = load_scenario(SCENARIO, doc=_doc(seed, imu, case))
     res = simulate_agenda(scn)
@@ -80,8 +80,13 @@ def replicate(args: tuple) -> dict:
         write_agenda_truth(res, d / "truth.nc")
         paths = write_trial_records(res, d)
         rec = open_record(paths["ship_motion"])
-        g = read_groups(d / "truth.nc")["groups"]["agenda"]["variables"]
+        tg = read_groups(d / "truth.nc")["groups"]["agenda"]
+        g = tg["variables"]
         cols = truth_columns(g, g["time"])
+        clock = imu_clock(tg["attrs"])
+
+        def score_compat(red, rec, cols, over_ground=False):
+            return _score(red, rec, cols, over_ground=over_ground, clock=clock)
         t_sim = time.perf_counter() - t_start
         if case == "nominal":
             t0, t1 = run_window(rec, length_s=NOMINAL)

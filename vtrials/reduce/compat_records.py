@@ -14,9 +14,11 @@ What the team knows and uses (all from the record and its instruments' meta):
 * v ≈ 0 and w ≈ 0 on every sample (seed 003 §3.2: the mean sway and heave velocities of a ship on a
   steady course vanish); weights ``sway_sigma``, ``heave_sigma`` (about the RMS of the motion).
 * Mean attitude, ``attitude_source``:
-  ``"reference"`` — the record means of an attitude instrument (vertical gyro), σ = its stated zero
-  accuracy (meta ``bias_std``): a one-number (average) observation in the one-stage fit; in the
-  two-stage fit a per-sample steady attitude at that mean, weighted by the instrument's RMS about its mean;
+  ``"reference"`` — an attitude instrument's roll and pitch (vertical gyro), per sample, weighted by
+  its reading step, with its stated zero accuracy (meta ``bias_std``) as an error constant over the
+  record whose effect on every parameter is added to the bound (``Observation.drift``): the mean
+  attitude it gives is only as good as that zero (a horizontal accelerometer bias is known to
+  g·bias_std), while the rate gyro biases come from its trends;
   ``"accelerometers"`` — seed 003 §3.2: roll and pitch "attitudes" from the specific force
   (:func:`vtrials.reduce.compat.accelerometer_attitude`, centripetal term removed with the log speed),
   a straight line fitted over the record and used per sample, weighted by their scatter about the line.
@@ -46,6 +48,7 @@ _WHERE = "compat_records"
 D = math.pi / 180.0
 EV_EXECUTE, EV_FINEX = 2, 3
 BIASES = ("b_p", "b_q", "b_r", "b_ax", "b_ay", "b_az")
+CONSTANT_TAU_S = 1e9  # a zero error constant over any record, as a Gauss–Markov drift
 ONE_STAGE_FREE = C.ATTITUDE_PARAMETERS + C.MOTION_PARAMETERS
 
 
@@ -176,14 +179,17 @@ def compat_data(record: Record, t0: float, t1: float, *, imu: str = "imu", headi
         if not sig0 > 0:
             raise InputError(f, f"{attitude}.meta.bias_std", "the attitude reference states no zero accuracy; "
                                                              "allowed: > 0 rad")
+        res = float(ma.get("resolution", 0.0))
+        lat_a = float(ma.get("latency_s", 0.0))
         for k in ("roll", "pitch"):
             ta, ya = record.channel(attitude, k)
             w = (ta >= t0) & (ta <= t1) & np.isfinite(ya)
-            mean = float(np.mean(ya[w]))
-            obs[k] = C.Observation(mean, sig0, True)
-            two[k] = C.Observation(np.full(n, mean), max(float(np.std(ya[w])), sig0))
-            notes[f"mean_{k}_rad"] = mean
-        notes["attitude_sigma_rad"] = sig0
+            # per sample, weighted by its reading step (at least 0.01°); its zero error is constant over
+            # the record: a drift of infinite correlation time, whose effect the bound carries
+            obs[k] = C.Observation(_on_grid(t, ta - lat_a, ya), max(res, 0.01 * D), drift=(sig0, CONSTANT_TAU_S))
+            two[k] = obs[k]
+            notes[f"mean_{k}_rad"] = float(np.mean(ya[w]))
+        notes["attitude_zero_sigma_rad"] = sig0
     else:
         speed = float(np.nanmean(obs["u"].values)) if "u" in obs else None
         roll_a, pitch_a = C.accelerometer_attitude(imu_rec, speed=speed)

@@ -6,8 +6,9 @@ everything the instrument added to its true measurand,
 
     b_true = mean over the fit's IMU samples of (recorded − true measurand at the IMU site),
 
-with the true measurand (specific force including the lever-arm terms, body rates) computed from the
-truth file by :class:`vtrials.instruments.kinematics.SiteKinematics` and interpolated linearly to the
+at the true instants of the recorded stamps (the IMU's logger clock, drawn and kept in the truth file,
+inverted: :func:`true_time`), with the true measurand (specific force including the lever-arm terms,
+body rates) computed from the truth file by :class:`vtrials.instruments.kinematics.SiteKinematics` and interpolated linearly to the
 recorded time stamps exactly as the IMU's own sampling does (:class:`vtrials.instruments.parts.Resample`).
 This is the drawn turn-on bias plus the window means of the bias instability (Gauss–Markov) and bias
 random walk, plus misalignment and scale factor acting on the window-mean measurand (for the horizontal
@@ -44,6 +45,24 @@ def truth_columns(truth_vars: dict, t_truth: np.ndarray) -> dict:
     return cols
 
 
+def imu_clock(truth_attrs: dict, imu: str = "imu") -> dict | None:
+    """The IMU's drawn logger clock from the truth file's ``instrument_errors`` (None: true time)."""
+    import json
+    errs = truth_attrs.get("instrument_errors")
+    errs = json.loads(errs) if isinstance(errs, str) else (errs or {})
+    return (errs.get(imu) or {}).get("logger_clock")
+
+
+def true_time(t_rec: np.ndarray, clock: dict | None) -> np.ndarray:
+    """Simulation time of recorded stamps: the logger clock stamps t + c + d·(t − t_ref)
+    (:class:`vtrials.instruments.parts.ClockOffset`), inverted."""
+    t_rec = np.asarray(t_rec, float)
+    if not clock:
+        return t_rec
+    c, d, tr = float(clock["offset_s"]), float(clock["drift_ppm"]) * 1e-6, float(clock["t_ref_s"])
+    return (t_rec - c + d * tr) / (1.0 + d)
+
+
 def _interp(t_out: np.ndarray, t: np.ndarray, y: np.ndarray) -> np.ndarray:
     if y.ndim == 1:
         return np.interp(t_out, t, y)
@@ -58,12 +77,14 @@ def true_imu(cols: dict, site, t_rec: np.ndarray) -> dict:
     return {"ax": sf[:, 0], "ay": sf[:, 1], "az": sf[:, 2], "p": om[:, 0], "q": om[:, 1], "r": om[:, 2]}
 
 
-def true_biases(record, cols: dict, t0: float, t1: float, imu: str = "imu") -> dict:
-    """Effective bias of each IMU channel over [t0, t1] (module note): name → value [SI]."""
+def true_biases(record, cols: dict, t0: float, t1: float, imu: str = "imu", clock: dict | None = None) -> dict:
+    """Effective bias of each IMU channel over [t0, t1] of record time (module note): name → value [SI].
+    ``clock``: the IMU's drawn logger clock (:func:`imu_clock`), to find the true instants of the
+    recorded stamps."""
     t_rec, _ = record.channel(imu, "p")
     sel = (t_rec >= t0) & (t_rec <= t1)
     site = record.meta(imu)["surveyed_position_m"]  # the surveyed position is the true site here
-    tru = true_imu(cols, site, t_rec[sel])
+    tru = true_imu(cols, site, true_time(t_rec[sel], clock))
     return {b: float(np.mean(record.channel(imu, ch)[1][sel] - tru[ch])) for b, ch in IMU_CHANNELS}
 
 
@@ -89,10 +110,10 @@ def _covers(e: dict, x: float) -> bool:
     return bool(e["lo95"] <= x <= e["hi95"])
 
 
-def score_stage(stage: dict, biases: dict, cols: dict, over_ground: bool = False) -> dict:
+def score_stage(stage: dict, biases: dict, cols: dict, over_ground: bool = False, clock: dict | None = None) -> dict:
     """Errors, coverage and reconstruction RMS errors of one stage's result."""
     t = np.asarray(stage["states"]["time"], float)
-    tru = true_states(cols, t)
+    tru = true_states(cols, true_time(t, clock))
     est = stage["estimates"]
     out = {"biases": {}, "invariants": {}, "state_rms": {}}
     for b in biases:
@@ -115,12 +136,14 @@ def score_stage(stage: dict, biases: dict, cols: dict, over_ground: bool = False
     return out
 
 
-def score_compat(reduced: dict, record, cols: dict, imu: str = "imu", over_ground: bool = False) -> dict:
-    """Score every stage of :func:`vtrials.reduce.compat_records.reduce_compat`'s output."""
+def score_compat(reduced: dict, record, cols: dict, imu: str = "imu", over_ground: bool = False,
+                 clock: dict | None = None) -> dict:
+    """Score every stage of :func:`vtrials.reduce.compat_records.reduce_compat`'s output; ``clock``: the
+    IMU's drawn logger clock (:func:`imu_clock`)."""
     t0, t1 = reduced["window"]
-    b = true_biases(record, cols, t0, t1, imu)
+    b = true_biases(record, cols, t0, t1, imu, clock)
     out = {"true_biases": b}
     for st in ("one_stage", "two_stage"):
         if st in reduced:
-            out[st] = score_stage(reduced[st], b, cols, over_ground)
+            out[st] = score_stage(reduced[st], b, cols, over_ground, clock)
     return out
