@@ -222,24 +222,32 @@ def main(argv=None) -> int:
     jobs = [(s, a.imu, a.case) for s in seeds]
     t0 = time.perf_counter()
     reps = []
+
+    def save(final: bool) -> dict:
+        doc = {"scenario": SCENARIO.name, "imu": a.imu, "case": a.case, "replicates": len(reps),
+               "replicates_planned": a.replicates, "complete": final,
+               "campaign_seed": a.seed, "lengths_s": LENGTHS, "nominal_s": NOMINAL,
+               "wall_s": time.perf_counter() - t0, "summary": summarise(reps, a.case), "replicates_detail": reps}
+        if a.out:
+            a.out.parent.mkdir(parents=True, exist_ok=True)
+            a.out.write_text(json.dumps(doc, indent=1, default=float) + "\n")
+        return doc
+
+    def done(i: int) -> None:
+        if (i + 1) % 10 == 0:
+            print(f"{i + 1}/{len(jobs)} {time.perf_counter() - t0:.0f} s", flush=True)
+            save(False)  # partial results survive an interrupted campaign
+
     if a.workers > 1:
         with ProcessPoolExecutor(a.workers) as ex:
             for i, r in enumerate(ex.map(replicate, jobs)):
                 reps.append(r)
-                if (i + 1) % 10 == 0:
-                    print(f"{i + 1}/{len(jobs)} {time.perf_counter() - t0:.0f} s", flush=True)
+                done(i)
     else:
         for i, j in enumerate(jobs):
             reps.append(replicate(j))
-            if (i + 1) % 10 == 0:
-                print(f"{i + 1}/{len(jobs)} {time.perf_counter() - t0:.0f} s", flush=True)
-    doc = {"scenario": SCENARIO.name, "imu": a.imu, "case": a.case, "replicates": a.replicates,
-           "campaign_seed": a.seed, "lengths_s": LENGTHS, "nominal_s": NOMINAL,
-           "wall_s": time.perf_counter() - t0, "summary": summarise(reps, a.case), "replicates_detail": reps}
-    text = json.dumps(doc, indent=1, default=float)
-    if a.out:
-        a.out.parent.mkdir(parents=True, exist_ok=True)
-        a.out.write_text(text + "\n")
+            done(i)
+    doc = save(True)
     print(json.dumps(doc["summary"], indent=1, default=float)[:20000])
     return 0
 

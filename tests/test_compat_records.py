@@ -61,8 +61,9 @@ def test_steady_run_holds_course_and_speed_for_hold_s(run):
 
 
 def test_adapter_recovers_the_effective_biases_and_the_motion(run):
-    """Reduced from the record: every effective IMU bias (score/compat.py's reference) and both invariant
-    combinations within 4 bounds of the truth (one-stage, vertical-gyro mean attitude); roll, pitch and
+    """Reduced from the record: every effective IMU bias (score/compat.py's reference) within 4 bounds of
+    the truth (one-stage, vertical-gyro attitude); the invariant combinations as the observations
+    make them; roll, pitch and
     the heave velocity reconstructed to a small fraction of their true RMS (the kinematics integrated
     from the IMU against the simulator's state)."""
     from vtrials.reduce.compat_records import reduce_compat
@@ -73,8 +74,17 @@ def test_adapter_recovers_the_effective_biases_and_the_motion(run):
     sc = score_compat(red, rec, cols, clock=clock)["one_stage"]
     for b, d in sc["biases"].items():
         assert abs(d["error"]) < 4 * d["std"], (b, d)
-    for k, d in sc["invariants"].items():
-        assert abs(d["error"]) < 4 * d["std"], (k, d)
+    # b_ax + g θ̄ is fixed by the log: within 4 bounds of the truth; b_ay − g φ̄ by v ≈ 0, so it is off by
+    # the trend of the true sway through the water (the assumption's error, seed 003 §5.1): its error
+    # is that trend (least-squares slope of the true v_r over the window) to within 4 bounds
+    from vtrials.score.compat import true_states, true_time
+    dx = sc["invariants"]["x"]
+    assert abs(dx["error"]) < 4 * dx["std"], dx
+    t = np.asarray(red["one_stage"]["states"]["time"])
+    v_r = true_states(cols, true_time(t, clock))["v_r"]
+    slope = np.polyfit(t - t[0], v_r, 1)[0]
+    dy = sc["invariants"]["y"]
+    assert abs(dy["error"] - slope) < 4 * dy["std"], (dy, slope)
     rms = sc["state_rms"]
     assert rms["roll"] < 0.1 * rms["roll_true_rms"]
     assert rms["pitch"] < 0.15 * rms["pitch_true_rms"]

@@ -571,9 +571,26 @@ def _drift_covariance(sens: dict, obs: dict, observations: Mapping[str, Observat
         s = sens[name]
         ok = np.isfinite(obs[name][0])
         g = cov_w @ (np.where(ok[:, None], s, 0.0) / obs[name][1] ** 2).T  # (npar, N)
-        sig = sd ** 2 * np.exp(-np.abs(t[:, None] - t[None, :]) / tau)
-        out += g @ sig @ g.T
+        out += sd ** 2 * g @ _exponential_kernel(t, np.ascontiguousarray(g.T), tau)
     return 0.5 * (out + out.T)
+
+
+@nb.njit(cache=True)
+def _exponential_kernel(t, x, tau):
+    """Σ_j exp(−|t_i − t_j|/τ) x_j for every i, in O(N) by a forward and a backward first-order
+    recursion (the kernel factors as exp(−(t_i − t_j)/τ) = Π of the one-step factors)."""
+    n, m = x.shape
+    fwd = np.empty((n, m))
+    bwd = np.empty((n, m))
+    fwd[0] = x[0]
+    for i in range(1, n):
+        a = math.exp(-(t[i] - t[i - 1]) / tau)
+        fwd[i] = a * fwd[i - 1] + x[i]
+    bwd[n - 1] = x[n - 1]
+    for i in range(n - 2, -1, -1):
+        a = math.exp(-(t[i + 1] - t[i]) / tau)
+        bwd[i] = a * bwd[i + 1] + x[i]
+    return fwd + bwd - x
 
 
 def _parameter_vector(imu: ImuRecord, obs: dict, initial: Mapping[str, float] | None) -> np.ndarray:
