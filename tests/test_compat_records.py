@@ -165,3 +165,17 @@ def test_drift_bound_equals_the_least_squares_slope_variance():
     assert got == pytest.approx(expect, rel=1e-4)
     with pytest.raises(InputError, match="drift"):
         C.compat_fit(imu, {"heading": C.Observation(np.zeros(n), 0.01, drift=(sd, -1.0))}, ("b_r",))
+
+
+def test_maneuvering_reduction_runs_compat_on_a_steady_run(run):
+    """The trial's own reduction (reduce_record → maneuvering) gives a steady run its Compat result
+    from the record, the same as the adapter called directly."""
+    from vtrials.reduce.compat_records import reduce_compat
+    from vtrials.reduce.trials import reduce_record
+    _, rec, _, _ = run
+    r = reduce_record(rec)["runs"][0]
+    assert r["type"] == "steady"
+    direct = reduce_compat(rec, stages=("one",))
+    for b in ("b_p", "b_r", "b_az"):
+        assert r["compat"]["one_stage"]["estimates"][b]["value"] == pytest.approx(
+            direct["one_stage"]["estimates"][b]["value"], rel=1e-9, abs=1e-15)
