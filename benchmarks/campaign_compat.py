@@ -135,6 +135,17 @@ def _slim(sc: dict) -> dict:
     return {k: v for k, v in sc.items()}
 
 
+def _round(x):
+    """Six significant digits: the results file stays small."""
+    if isinstance(x, float):
+        return float(f"{x:.6g}")
+    if isinstance(x, dict):
+        return {k: _round(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_round(v) for v in x]
+    return x
+
+
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     if n == 0:
         return (math.nan, math.nan)
@@ -246,7 +257,7 @@ def main(argv=None) -> int:
                "wall_s": time.perf_counter() - t0, "summary": summarise(reps, a.case), "replicates_detail": reps}
         if a.out:
             a.out.parent.mkdir(parents=True, exist_ok=True)
-            a.out.write_text(json.dumps(doc, indent=1, default=float) + "\n")
+            a.out.write_text(json.dumps(_round(doc), default=float, separators=(",", ":")) + "\n")
         return doc
 
     def done(i: int) -> None:
