@@ -51,7 +51,10 @@ channel) whose lowest band — emptied by the fit itself, and exactly where bias
 refilled from the neighbouring band, and with Satterthwaite degrees of freedom so that intervals use
 Student's t (see :func:`_coloured_covariance` for why, and for the variants that failed). Measured 95 %
 coverage of the six biases on synthetic replicates: 0.925–0.985 (200, seeds 1000+, on which REFILL was
-chosen), 0.90–0.965 and 0.93–0.98 (two independent sets of 200, seeds 9000+ and 9200+). Input noise (gyro and
+chosen), 0.90–0.965 and 0.93–0.98 (two independent sets of 200, seeds 9000+ and 9200+). A slowly varying observation error that a
+data sheet states (a gyrocompass's wander, a vertical gyro's zero: ``Observation.drift``) is a trend the
+fit absorbs into a bias and cannot see in its residuals; its effect G Σ Gᵀ is added to both bounds
+(:func:`_drift_covariance`; on simulator records, vtrials/reduce/compat_records.py). Input noise (gyro and
 accelerometer white noise integrated into random walks) is process noise that an output-error fit does
 not model: it is not in either bound (a 0.003 °/s white gyro noise at 10 Hz drops the b_r coverage
 to 0.88; with navigation-grade 0.0005 °/s, as in the tests, it is negligible).
