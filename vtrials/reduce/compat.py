@@ -51,7 +51,10 @@ channel) whose lowest band — emptied by the fit itself, and exactly where bias
 refilled from the neighbouring band, and with Satterthwaite degrees of freedom so that intervals use
 Student's t (see :func:`_coloured_covariance` for why, and for the variants that failed). Measured 95 %
 coverage of the six biases on synthetic replicates: 0.925–0.985 (200, seeds 1000+, on which REFILL was
-chosen), 0.90–0.965 and 0.93–0.98 (two independent sets of 200, seeds 9000+ and 9200+). Input noise (gyro and
+chosen), 0.90–0.965 and 0.93–0.98 (two independent sets of 200, seeds 9000+ and 9200+). A slowly varying observation error that a
+data sheet states (a gyrocompass's wander, a vertical gyro's zero: ``Observation.drift``) is a trend the
+fit absorbs into a bias and cannot see in its residuals; its effect G Σ Gᵀ is added to both bounds
+(:func:`_drift_covariance`; on simulator records, vtrials/reduce/compat_records.py). Input noise (gyro and
 accelerometer white noise integrated into random walks) is process noise that an output-error fit does
 not model: it is not in either bound (a 0.003 °/s white gyro noise at 10 Hz drops the b_r coverage
 to 0.88; with navigation-grade 0.0005 °/s, as in the tests, it is negligible).
@@ -141,11 +144,17 @@ class Observation:
     values: (N,) on the IMU time grid (NaN = not observed at that sample), or, with ``average=True``,
     one number compared with the record mean of the modelled channel (e.g. a mean heel from an
     inclinometer). sigma: the stated standard deviation of one value [channel unit, SI].
+    drift: (sd, τ) of a slowly varying error of the channel that its data sheet states (first-order
+    Gauss–Markov, e.g. a gyrocompass's wander): over a short record it is a near-linear trend that the
+    fit absorbs into a bias (a heading trend is a yaw-rate bias), invisible in the residuals, so its
+    effect G Σ Gᵀ (G = M⁻¹ Sᵀ R⁻¹ of that channel, Σ_ij = sd² exp(−|t_i − t_j|/τ)) is added to the
+    bound (:func:`compat_fit`).
     """
 
     values: np.ndarray | float
     sigma: float
     average: bool = False
+    drift: tuple[float, float] | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -395,6 +404,11 @@ def _check_observations(observations: Mapping[str, Observation], n: int) -> dict
             if np.count_nonzero(np.isfinite(v)) < 2:
                 raise InputError(_WHERE, f"observations.{name}.values", "fewer than 2 finite samples")
             obs[name] = (v, float(o.sigma), False)
+        if o.drift is not None:
+            sd, tau = (float(x) for x in o.drift)
+            if o.average or not (sd >= 0 and math.isfinite(sd) and tau > 0 and math.isfinite(tau)):
+                raise InputError(_WHERE, f"observations.{name}.drift", f"value {o.drift!r}; allowed: (sd ≥ 0, "
+                                 f"tau > 0) on a per-sample channel")
     return obs
 
 
@@ -548,6 +562,40 @@ def _coloured_covariance(sens: dict, obs: dict, res: dict, cov_w: np.ndarray, re
     return cov, dof
 
 
+def _drift_covariance(sens: dict, obs: dict, observations: Mapping[str, Observation], t: np.ndarray,
+                      cov_w: np.ndarray) -> np.ndarray:
+    """Σ_c G_c Σ_c G_cᵀ over the channels with a stated drift (see :class:`Observation`)."""
+    npar = cov_w.shape[0]
+    out = np.zeros((npar, npar))
+    for name, o in observations.items():
+        if o.drift is None or o.drift[0] == 0.0:
+            continue
+        sd, tau = (float(x) for x in o.drift)
+        s = sens[name]
+        ok = np.isfinite(obs[name][0])
+        g = cov_w @ (np.where(ok[:, None], s, 0.0) / obs[name][1] ** 2).T  # (npar, N)
+        out += sd ** 2 * g @ _exponential_kernel(t, np.ascontiguousarray(g.T), tau)
+    return 0.5 * (out + out.T)
+
+
+@nb.njit(cache=True)
+def _exponential_kernel(t, x, tau):
+    """Σ_j exp(−|t_i − t_j|/τ) x_j for every i, in O(N) by a forward and a backward first-order
+    recursion (the kernel factors as exp(−(t_i − t_j)/τ) = Π of the one-step factors)."""
+    n, m = x.shape
+    fwd = np.empty((n, m))
+    bwd = np.empty((n, m))
+    fwd[0] = x[0]
+    for i in range(1, n):
+        a = math.exp(-(t[i] - t[i - 1]) / tau)
+        fwd[i] = a * fwd[i - 1] + x[i]
+    bwd[n - 1] = x[n - 1]
+    for i in range(n - 2, -1, -1):
+        a = math.exp(-(t[i + 1] - t[i]) / tau)
+        bwd[i] = a * bwd[i + 1] + x[i]
+    return fwd + bwd - x
+
+
 def _parameter_vector(imu: ImuRecord, obs: dict, initial: Mapping[str, float] | None) -> np.ndarray:
     par = np.zeros(len(PARAMETERS))
 
@@ -641,7 +689,9 @@ def compat_fit(imu: ImuRecord, observations: Mapping[str, Observation], free: Se
     m, _ = _information(sens, obs, res)
     cov_w = np.linalg.inv(m)
     cov_c, dof_c = _coloured_covariance(sens, obs, res, cov_w, refill)
-    cov = cov_c if bounds == "coloured" else cov_w
+    cov_d = _drift_covariance(sens, obs, observations, imu.time_s, cov_w)
+    cov_c = cov_c + cov_d
+    cov = cov_c if bounds == "coloured" else cov_w + cov_d
     std = np.sqrt(np.diag(cov))
     dof = dof_c if bounds == "coloured" else np.full(std.size, np.inf)
     corr = cov / np.outer(std, std)

@@ -380,6 +380,28 @@ def _clean(d):
     return d
 
 
+def _steady_compat(rec: Record, r: dict) -> dict:
+    """A steady run: Compat (:mod:`vtrials.reduce.compat_records`) on EXECUTE → FINEX when the record
+    has an IMU, a heading reference and a log (mean attitude from an attitude instrument when there is
+    one, else from the accelerometers); states kept at about 1 Hz."""
+    from vtrials.errors import InputError
+    from vtrials.reduce.compat_records import reduce_compat
+    k = instruments_by_kind(rec)
+    if not (k.get("imu") and k.get("heading") and k.get("em_log")):
+        return {"compat": {"error": "no IMU, heading reference or log in the record"}}
+    ti, _ = rec.channel(k["imu"][0], "p")
+    every = max(1, int(round(1.0 / max(float(np.median(np.diff(ti))), 1e-6))))
+    try:
+        c = reduce_compat(rec, r["t_execute"], r["t_finex"], imu=k["imu"][0], heading=k["heading"][0],
+                          log=k["em_log"][0],
+                          attitude=(k.get("attitude") or [None])[0] or "",
+                          attitude_source="reference" if k.get("attitude") else "accelerometers",
+                          states_every=every)
+    except (InputError, ValueError, np.linalg.LinAlgError) as exc:
+        return {"compat": {"error": f"{type(exc).__name__}: {exc}"}}
+    return {"compat": _clean(c)}
+
+
 def reduce_maneuvering(rec: Record) -> dict:
     ch = Channels(rec)
     runs = sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
@@ -535,6 +557,8 @@ def reduce_maneuvering(rec: Record) -> dict:
                 after = ch.window(r["t_finex"] - 60.0, r["t_finex"])
                 d["rate_before_release"] = _clean(_rate(before["t_heading"], before["heading"]))
                 d["residual_rate"] = _clean(_rate(after["t_heading"], after["heading"]))
+            elif kind == "steady":
+                d.update(_steady_compat(rec, r))
             elif kind == "backing":
                 ap = ch.window(r["t_comex"], r["t_execute"])
                 vn, ve = _rate(ap["t"], ap["north"]), _rate(ap["t"], ap["east"])

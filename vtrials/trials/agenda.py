@@ -41,7 +41,7 @@ from vtrials.units import DEG, KNOT, RPM
 
 ORDERS = ("ahead_1_3", "ahead_2_3", "standard", "full", "flank")
 ALL_ORDERS = ORDERS + ("stop", "back_1_3", "back_2_3", "back_full", "back_emergency")
-MANEUVERS = ("turn", "speed_change", "direct_spiral", "reverse_spiral", "zigzag", "pull_out", "backing")
+MANEUVERS = ("turn", "speed_change", "direct_spiral", "reverse_spiral", "zigzag", "pull_out", "backing", "steady")
 DIEUDONNE = [15.0, 10.0, 7.5, 5.0, 2.0, 0.0, -2.0, -5.0, -7.5, -10.0, -15.0, -10.0, -7.5, -5.0, -2.0, 0.0, 2.0,
              5.0, 7.5, 10.0, 15.0]
 
@@ -163,7 +163,8 @@ class ManeuverSpec(Setting):
     rates_deg_s: list = vector("reverse spiral: rates of turn to hold in order", "deg/s", -20.0, 20.0,
                                default=None)
     hold_s: float = num("spirals: data kept at each setting once it is steady (seed 002: ~2 min); pull-out "
-                        "and backing: time after the rudder is centred / put over", "s", 10.0, 7200.0,
+                        "and backing: time after the rudder is centred / put over; steady: length of the "
+                        "straight run (seed 003: 60-118 s motion records)", "s", 10.0, 7200.0,
                         default=None)
     max_setting_s: float = num("spirals: give a setting up (reported) if not steady after this", "s", 60.0,
                                36000.0, default=1800.0)
@@ -511,7 +512,8 @@ def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pit
         if len(m.rates_deg_s) < 3:
             raise InputError(f, f"{sec}.rates_deg_s", "a reverse spiral needs at least 3 rates of turn")
         p["rates"] = [r * DEG for r in m.rates_deg_s]
-    defaults_hold = {"direct_spiral": 120.0, "reverse_spiral": 120.0, "pull_out": 300.0, "backing": 300.0}
+    defaults_hold = {"direct_spiral": 120.0, "reverse_spiral": 120.0, "pull_out": 300.0, "backing": 300.0,
+                     "steady": 90.0}  # seed 003: the usual airwake-trial record is 90 s
     p["hold_s"] = m.hold_s if m.hold_s is not None else defaults_hold.get(m.type, 0.0)
     p["max_setting_s"] = m.max_setting_s
     p["helm_miss"] = m.helm_miss_deg * DEG
@@ -529,7 +531,7 @@ def _maneuver_run(m: ManeuverSpec, number: int, trial: str, index: int, rps, pit
     heading = (m.course_deg if m.course_deg is not None else base) * DEG
     what = {"turn": "turn", "speed_change": "speed change", "direct_spiral": "direct spiral",
             "reverse_spiral": "reverse spiral", "zigzag": "zig-zag", "pull_out": "pull-out",
-            "backing": "backing"}[m.type]
+            "backing": "backing", "steady": "steady run"}[m.type]
     extra = "" if m.rudder_deg is None else f" {abs(m.rudder_deg):g}°{'S' if m.rudder_deg > 0 else 'P'}"
     if m.type == "zigzag":
         extra = f" {abs(m.rudder_deg):g}/{p['check'] / DEG:g} {'S' if m.rudder_deg > 0 else 'P'}"

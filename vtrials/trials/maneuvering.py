@@ -16,7 +16,10 @@ minute), then at EXECUTE the maneuver, watched on the instruments until FINEX:
 * ``reverse_spiral`` — the helm holds each rate of turn (Bech); same steadiness rule;
 * ``pull_out`` — a steady turn, then rudder amidships; FINEX ``hold_s`` later;
 * ``backing`` — the approach is made astern at the run's order, the rudder put hard over at EXECUTE;
-  FINEX ``hold_s`` later.
+  FINEX ``hold_s`` later;
+* ``steady`` — nothing changes at EXECUTE: the course-keeping helm holds the approach course at the
+  approach setting, FINEX ``hold_s`` later (a ship-motion record on a steady heading and speed, seed
+  003's 60-118 s records for Compat).
 
 Every decision is taken on instrument readings (gyro, tracking fixes, log); the truth only flows into
 the truth references (:func:`maneuver_truth`).
@@ -202,6 +205,9 @@ def execute(crew, run: Run, att) -> None:
         crew._helm([(H.HOLD, p["rudder"], 0.0)])
         crew.advance(p["hold_s"])
         done = True
+    elif kind == "steady":
+        crew.advance(p["hold_s"])
+        done = True
     if not done and kind not in ("direct_spiral", "reverse_spiral"):
         att.run_notes.append(f"FINEX condition not reached within {limit:.0f} s of EXECUTE: run stopped")
     att.completed = done
@@ -254,6 +260,13 @@ def maneuver_truth(run: Run, att, cols: dict) -> dict:
                         "speed": float(np.mean(np.hypot(c["u_r"][m], c["v_r"][m]))) if m.any() else math.nan,
                         "steady": s["steady"], "t0": t0, "t1": s["t_end"]})
         out["points"] = pts
+    elif kind == "steady":
+        out["mean_speed_mps"] = float(np.mean(np.hypot(c["u_r"], c["v_r"])))
+        out["mean_heading_rad"] = float(np.angle(np.mean(np.exp(1j * c["heading"]))))
+        for k in ("roll", "pitch"):
+            out[f"mean_{k}_rad"] = float(np.mean(c[k]))
+            out[f"rms_{k}_rad"] = float(np.std(c[k]))
+        out["drift"] = [float(np.mean(c["current_n"])), float(np.mean(c["current_e"]))]
     elif kind == "backing":
         m = c["t"] >= att.t_execute
         out["astern_speed_mps"] = float(np.mean(c["u_r"][c["t"] <= att.t_execute + 1.0]))
