@@ -61,3 +61,16 @@ def test_every_shipped_scenario_loads(path):
     from vtrials.scenario import load_scenario
     scn = load_scenario(path)
     assert scn.maneuvers or scn.agenda is not None
+
+
+def test_summary_line_reads_every_trial_kinds_scores():
+    """The run command's closing lines: a trial scored per run (error.summary) and a seakeeping trial
+    scored per leg and response (summary, one level deeper) both print their scalars (a seakeeping
+    trial had no error.summary and the command stopped with a KeyError after writing its outputs)."""
+    from vtrials.cli import summary_line
+    std = {"name": "std", "kind": "standardization", "error": {"summary": {"max_power_error": 0.0123, "runs": [1]}}}
+    assert "max_power_error 0.0123" in summary_line(std)
+    sk = {"name": "sk", "kind": "seakeeping", "legs": [],
+          "summary": {"heave": {"bins": 12, "median_abs_amp_error": 0.021, "ok": True}}}
+    line = summary_line(sk)
+    assert "heave bins 12" in line and "heave median_abs_amp_error 0.021" in line and "ok" not in line

@@ -247,6 +247,16 @@ def _inspect(args) -> int:
     return 0
 
 
+def summary_line(tr: dict) -> str:
+    """One line of a trial's scores: the scalars of its summary (``error.summary``, or ``summary`` for
+    trials scored per leg, whose entries may be one level deeper, e.g. per response)."""
+    sm = (tr.get("error") or {}).get("summary", tr.get("summary", {}))
+    flat = {f"{k} {k2}" if isinstance(v, dict) else k: v2
+            for k, v in sm.items() for k2, v2 in (v.items() if isinstance(v, dict) else [(k, v)])}
+    return f"  {tr['name']:<20} {tr['kind']:<16} " + ", ".join(
+        f"{k} {v:.4g}" for k, v in flat.items() if isinstance(v, (int, float)) and not isinstance(v, bool))
+
+
 def _run_agenda(scn, args) -> int:
     """An agenda: the crew's progress per run, then the scores of every trial."""
     from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
@@ -262,9 +272,7 @@ def _run_agenda(scn, args) -> int:
     if say:
         say(f"trial time {doc['agenda']['total_time_s'] / 3600:.2f} h simulated in {doc['wall_time_s']:.1f} s wall time")
         for tr in doc["trials"]:
-            sm = tr["error"]["summary"]
-            say(f"  {tr['name']:<20} {tr['kind']:<16} " + ", ".join(
-                f"{k} {v:.4g}" for k, v in sm.items() if isinstance(v, (int, float))))
+            say(summary_line(tr))
         say(f"wrote {args.out}/results.json, truth.nc, records/*.nc" + ("" if args.no_plot else ", report.md"))
     return 0
 
