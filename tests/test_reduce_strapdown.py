@@ -19,31 +19,34 @@ N = 4096
 T = N * DT
 
 
-def _periodic(rng, rms, omega_peak, mean=0.0, n=40):
+def _periodic(rng, rms, omega_peak, mean=0.0, n=40, period=T):
     """Random-phase harmonics on the record's own frequencies k/T (the random-phase method gives a
     periodic record, as FFT integration assumes), Pierson–Moskowitz shape between 0.5 and 2.5 ω_p."""
-    k_lo = math.ceil(0.5 * omega_peak * T / (2 * math.pi))
-    k_hi = math.floor(2.5 * omega_peak * T / (2 * math.pi))
+    k_lo = math.ceil(0.5 * omega_peak * period / (2 * math.pi))
+    k_hi = math.floor(2.5 * omega_peak * period / (2 * math.pi))
     k = np.unique(np.linspace(k_lo, k_hi, n).round())
-    w = 2 * math.pi * k / T
+    w = 2 * math.pi * k / period
     amp = np.sqrt(w ** -5 * np.exp(-1.25 * (omega_peak / w) ** 4))
     amp *= rms / math.sqrt(np.sum(amp ** 2) / 2)
     return sm.Harmonics(amp, w, rng.uniform(0, 2 * math.pi, w.size), mean)
 
 
-def _record(rms_deg, seed=1, translation_rms=(0.5, 0.5, 1.0), arr=None):
+def _record(rms_deg, seed=1, translation_rms=(0.5, 0.5, 1.0), arr=None, period=None):
+    """period: the harmonics' fundamental period [s] (default the record length T: a periodic record;
+    another value puts every frequency off the record's own grid)."""
     rng = np.random.default_rng(seed)
+    per = T if period is None else period
     t = np.arange(N) * DT
     wp = 0.6
-    phi, th, psi = (_periodic(rng, rms_deg * D, wp, mean=2 * D), _periodic(rng, rms_deg * D, wp, mean=0.5 * D),
-                    _periodic(rng, rms_deg * D, wp))
+    phi, th, psi = (_periodic(rng, rms_deg * D, wp, mean=2 * D, period=per),
+                    _periodic(rng, rms_deg * D, wp, mean=0.5 * D, period=per), _periodic(rng, rms_deg * D, wp, period=per))
     (f, fd, fdd), (tt, td, tdd), (ps, pd, pdd) = phi(t), th(t), psi(t)
     sf, cf, st, ct = np.sin(f), np.cos(f), np.sin(tt), np.cos(tt)
     w = np.stack([fd - pd * st, td * cf + pd * ct * sf, -td * sf + pd * ct * cf], 1)
     wd = np.stack([fdd - pdd * st - pd * td * ct,
                    tdd * cf - td * fd * sf + pdd * ct * sf - pd * td * st * sf + pd * fd * ct * cf,
                    -tdd * sf - td * fd * cf + pdd * ct * cf - pd * td * st * cf - pd * fd * ct * sf], 1)
-    xs = [_periodic(rng, a, wp) for a in translation_rms]
+    xs = [_periodic(rng, a, wp, period=per) for a in translation_rms]
     x0 = np.stack([h(t)[0] for h in xs], 1)
     a0 = np.stack([h(t)[2] for h in xs], 1)
     a = sm.rotation(f, tt, ps)
@@ -66,6 +69,69 @@ def test_fft_integration_of_a_sinusoid():
     w = 2 * math.pi * 8 / (1024 * 0.05)
     got = S.fft_integrate(np.cos(w * t), 0.05, 0.01)
     assert np.max(np.abs(got - np.sin(w * t) / w)) < 1e-12
+
+
+@pytest.mark.parametrize("f0", [0.2013, 0.1971])
+def test_mirror_integration_of_a_non_periodic_sinusoid(f0):
+    """cos(2πf₀t + 0.7) over 300 s, not a whole number of cycles, cut-off 0.04 Hz: the mirror integration's
+    error against the analytic integral (about its mean) is below the FFT integration's (measured
+    0.77 % vs 1.58 % at 0.2013 Hz; 0.50 % vs 0.91 % at 0.1971 Hz) and below 1 % at the wave frequencies;
+    its high-pass passes a sinusoid 5 × the cut-off with the stated gain 1/(1 + (f_c/f)⁸) and no phase
+    shift in the middle of the record."""
+    dt = 0.05
+    t = np.arange(6000) * dt
+    w = 2 * math.pi * f0
+    truth = np.sin(w * t + 0.7) / w
+    truth -= truth.mean()
+    e_fft = S.nre(S.fft_integrate(np.cos(w * t + 0.7), dt, 0.04), truth)
+    e_mir = S.nre(S.mirror_integrate(np.cos(w * t + 0.7), dt, 0.04), truth)
+    print(f"f0 {f0}: NRE fft {e_fft:.3f} %, mirror {e_mir:.3f} %")
+    assert e_mir < 1.0 and e_mir < e_fft
+    hp = S.mirror_highpass(np.cos(2 * math.pi * 0.2 * t), dt, 0.04)
+    gain = 1.0 / (1.0 + (0.04 / 0.2) ** 8)  # the stated zero-phase response, order 4
+    mid = slice(1500, 4500)
+    assert np.max(np.abs(hp[mid] - gain * np.cos(2 * math.pi * 0.2 * t[mid]))) < 2e-4
+
+
+def test_mirror_integration_removes_a_bias():
+    """A constant bias on the integrand (an accelerometer offset) gives a ramp that the integration's
+    detrending removes exactly; 2-D input integrates column by column."""
+    dt = 0.1
+    t = np.arange(3000) * dt
+    w = 2 * math.pi * 0.15
+    x = np.column_stack([np.cos(w * t), np.cos(w * t) + 0.05])
+    y = S.mirror_integrate(x, dt, 0.03)
+    assert y.shape == x.shape
+    assert np.max(np.abs(y[:, 0] - y[:, 1])) < 1e-9
+    with pytest.raises(InputError, match="integration"):
+        S.strapdown_motion(t, np.zeros((t.size, 7)), S.miles_array(), 0.03, integration="spline")
+
+
+def test_non_periodic_record_with_mirror_integration():
+    """Miles' random-phase motion (5° RMS roll, pitch, yaw) on frequencies off the record's grid (period
+    T/0.9137): the FFT integration wraps the record (measured NRE 2.4 / 16.8 / 5.6 %); the mirror
+    integration meets Miles' 2 % (measured 0.8 / 1.4 / 1.0 %, heave 1.3 %)."""
+    t, acc, arr, euler, _, x0 = _record(5.0, period=N * DT / 0.9137)
+    res = S.strapdown_motion(t, acc, arr, cutoff_hz=0.02, rate_cutoff_hz=0.01, integration="mirror")
+    nre_ang = [S.nre(res.euler[:, i], euler[:, i]) for i in range(3)]
+    fft = S.strapdown_motion(t, acc, arr, cutoff_hz=0.02, rate_cutoff_hz=0.01)
+    nre_fft = [S.nre(fft.euler[:, i], euler[:, i]) for i in range(3)]
+    heave = S.nre(res.displacement[:, 2], x0[:, 2] - x0[:, 2].mean())
+    print("off-grid NRE mirror", np.round(nre_ang, 3).tolist(), "fft", np.round(nre_fft, 3).tolist(), "heave", round(heave, 3))
+    assert max(nre_ang) < 2.0 and heave < 2.0
+    assert max(nre_fft) > 2 * max(nre_ang)
+
+
+def test_suggested_cutoff_lies_below_the_wave_band():
+    """The synthetic spectra span 0.5–2.5 ω_p (ω_p 0.6 rad/s): the cut-off chosen from the readings lies
+    below the band's lower edge 0.5 ω_p/2π = 0.048 Hz and above 0.4 × it."""
+    t, acc, arr, _, _, _ = _record(5.0)
+    fc = S.suggest_cutoff(t, acc, arr)
+    lo = 0.5 * 0.6 / (2 * math.pi)
+    print(f"suggested cut-off {fc:.4f} Hz (band from {lo:.4f} Hz)")
+    assert 0.4 * lo < fc < lo
+    with pytest.raises(InputError, match="fraction"):
+        S.suggest_cutoff(t, acc, arr, fraction=0.0)
 
 
 @pytest.mark.parametrize("rms_deg", [5.0, 10.0, 15.0])

@@ -40,6 +40,7 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy.signal import welch
 
 from vtrials.errors import InputError
 from vtrials.units import G
@@ -128,6 +129,70 @@ def fft_integrate(x: np.ndarray, dt: float, cutoff_hz: float) -> np.ndarray:
     return np.fft.irfft(spec * factor.reshape((-1,) + (1,) * (x.ndim - 1)), n=n, axis=0)
 
 
+INTEGRATIONS = ("fft", "mirror")
+
+
+def mirror_integrate(x: np.ndarray, dt: float, cutoff_hz: float, order: int = 4) -> np.ndarray:
+    """∫x dt along axis 0 for a record that is NOT periodic: trapezoidal integration in the time domain,
+    a least-squares line removed (an integrand bias and the integration constant), then a zero-phase
+    high-pass |H|² = 1/(1 + (f_c/f)^(2·order)) applied by FFT to the record extended by its mirror image
+    (x(t), x(2T − t)), which is continuous at both joins, so no wrap-around step enters the filter;
+    the mirror half is discarded. Measured on a 0.2013-Hz sinusoid over 300 s (60.4 cycles, cut-off
+    0.04 Hz): NRE 0.77 % against 1.58 % for :func:`fft_integrate` (tests/test_reduce_strapdown.py).
+    order 4 (default): on patrol51's simulated quartering-sea records the roll/pitch/heave NRE was 0.3–1.3
+    points lower than with order 2 (a gentler knee removes wave-band motion near the cut-off)."""
+    x = np.asarray(x, float)
+    n = x.shape[0]
+    y = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(0.5 * (x[1:] + x[:-1]), axis=0) * dt], 0)
+    s = np.linspace(-1.0, 1.0, n)
+    v = np.column_stack([s, np.ones(n)])
+    flat = y.reshape(n, -1)
+    flat = flat - v @ np.linalg.lstsq(v, flat, rcond=None)[0]
+    return mirror_highpass(flat, dt, cutoff_hz, order).reshape(y.shape)
+
+
+def mirror_highpass(y: np.ndarray, dt: float, cutoff_hz: float, order: int = 4) -> np.ndarray:
+    """Zero-phase high-pass |H|² = 1/(1 + (f_c/f)^(2·order)) along axis 0, by FFT of the record extended
+    by its mirror image (the filter :func:`mirror_integrate` applies; also the band in which to compare
+    a reconstruction with a truth that has motion below the cut-off)."""
+    y = np.asarray(y, float)
+    n = y.shape[0]
+    flat = y.reshape(n, -1)
+    ext = np.concatenate([flat, flat[::-1]], 0)
+    f = np.fft.rfftfreq(2 * n, dt)
+    h = np.zeros(f.size)
+    h[1:] = 1.0 / (1.0 + (cutoff_hz / f[1:]) ** (2 * order))
+    return np.fft.irfft(np.fft.rfft(ext, axis=0) * h[:, None], n=2 * n, axis=0)[:n].reshape(y.shape)
+
+
+def _integrator(method: str):
+    if method == "fft":
+        return fft_integrate
+    if method == "mirror":
+        return mirror_integrate
+    raise InputError(_WHERE, "integration", f"value {method!r}; allowed: one of {INTEGRATIONS}")
+
+
+
+def suggest_cutoff(time_s: np.ndarray, accelerations: np.ndarray, array: AccelerometerArray,
+                   fraction: float = 0.2) -> float:
+    """A high-pass cut-off chosen from the records: ``fraction`` × the peak frequency of the summed
+    spectrum of the angular accelerations (linear solve; Welch, 256-s segments or the record). A
+    wave-excited (encounter) spectrum has little energy below about half its peak (the synthetic
+    records of tests/test_reduce_strapdown.py: 0.5 ω_p), and 0.4 × that lower edge is the cut-off used
+    for Miles' figure there, hence the default 0.2. Not below 2 / record length."""
+    t = np.asarray(time_s, float)
+    a = np.asarray(accelerations, float)
+    if t.ndim != 1 or t.size < 16 or a.shape != (t.size, array.positions.shape[0]):
+        raise InputError(_WHERE, "accelerations", f"shape {a.shape}; allowed: ({t.size}, {array.positions.shape[0]})")
+    if not (0 < fraction <= 1):
+        raise InputError(_WHERE, "fraction", f"value {fraction!r}; allowed: 0 < fraction ≤ 1")
+    dt = float(np.mean(np.diff(t)))
+    wdot = (a @ np.linalg.pinv(array.design).T)[:, 3:]
+    f, p = welch(wdot, fs=1.0 / dt, nperseg=min(t.size, int(round(256.0 / dt))), axis=0, detrend="linear")
+    return max(fraction * float(f[int(np.argmax(p.sum(axis=1)))]), 2.0 / (t[-1] - t[0]))
+
+
 def rotation_body_to_earth(roll, pitch, heading) -> np.ndarray:
     """A(φ, θ, ψ) = R_z(ψ) R_y(θ) R_x(φ), shape (..., 3, 3)."""
     sf, cf, st, ct = np.sin(roll), np.cos(roll), np.sin(pitch), np.cos(pitch)
@@ -167,7 +232,7 @@ class StrapdownMotion:
 def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: AccelerometerArray,
                      cutoff_hz: float, rate_cutoff_hz: float | None = None, gravity: float = G,
                      point: np.ndarray | None = None, max_iterations: int = 200,
-                     tolerance: float = 1e-10) -> StrapdownMotion:
+                     tolerance: float = 1e-10, integration: str = "fft") -> StrapdownMotion:
     """Miles' nonlinear iterative reconstruction.
 
     time_s (N,) uniform [s]; accelerations (N, n) readings of the array's sensors [m/s²] (specific force:
@@ -178,7 +243,9 @@ def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: Accel
     lower rate cut-off is more accurate — but the fixed-point iteration of Euler's equations
     ω⁽ⁿ⁺¹⁾ = ∫(F − ω⁽ⁿ⁾ × ω⁽ⁿ⁾) has a gain of about 2|ω|/(2πf) at frequency f and diverges below
     f ≈ |ω|/π; keep rate_cutoff_hz above that. point: body point Q [m] for the translations
-    (default C). Converged when the largest change of ω, φ, θ and the mean attitude between iterations
+    (default C). integration: "fft" (:func:`fft_integrate`, exact for a periodic record, as Miles'
+    simulations are) or "mirror" (:func:`mirror_integrate`, for a measured record, which never is).
+    Converged when the largest change of ω, φ, θ and the mean attitude between iterations
     is below ``tolerance`` (rad/s, rad).
     """
     t = np.asarray(time_s, float)
@@ -201,6 +268,7 @@ def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: Accel
     if not (isinstance(max_iterations, int) and max_iterations >= 1):
         raise InputError(_WHERE, "max_iterations", f"value {max_iterations!r}; allowed: integer ≥ 1")
     pinv = np.linalg.pinv(array.design)
+    integrate = _integrator(integration)  # the chosen integration
 
     # 1–2. rates and attitude, iterated together
     w_osc = np.zeros((t.size, 3))
@@ -212,14 +280,14 @@ def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: Accel
     it = 0
     for it in range(1, max_iterations + 1):
         sol = (a - _centripetal(w_osc + c, array)) @ pinv.T
-        w_new = fft_integrate(sol[:, 3:], dt, rate_cut)
+        w_new = integrate(sol[:, 3:], dt, rate_cut)
         fp, ft = phi + mean[0], th + mean[1]
         c_new = _zero_drift_rates(w_new, fp, ft)
         w = w_new + c_new
         phid, thd, psid = _euler_rates(w, fp, ft)
-        phi_new = fft_integrate(phid, dt, cutoff_hz)
-        th_new = fft_integrate(thd, dt, cutoff_hz)
-        psi = fft_integrate(psid, dt, cutoff_hz)
+        phi_new = integrate(phid, dt, cutoff_hz)
+        th_new = integrate(thd, dt, cutoff_hz)
+        psi = integrate(psid, dt, cutoff_hz)
         f_c = sol[:, :3]
         mean_new = _mean_attitude(phi_new, th_new, psi, f_c, mean)
         change = max(float(np.max(np.abs(w_new + c_new - w_osc - c))), float(np.max(np.abs(phi_new - phi))),
@@ -236,7 +304,7 @@ def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: Accel
     wdot = sol[:, 3:]
     phi = phi + mean[0]
     th = th + mean[1]
-    psi = fft_integrate(_euler_rates(w, phi, th)[2], dt, cutoff_hz)
+    psi = integrate(_euler_rates(w, phi, th)[2], dt, cutoff_hz)
 
     # 3. translations at C (or Q)
     f_q = f_c
@@ -248,8 +316,8 @@ def strapdown_motion(time_s: np.ndarray, accelerations: np.ndarray, array: Accel
     amat = rotation_body_to_earth(phi, th, psi)
     acc = np.einsum("nij,nj->ni", amat, f_q)
     acc[:, 2] += gravity
-    vel = fft_integrate(acc, dt, cutoff_hz)
-    disp = fft_integrate(vel, dt, cutoff_hz)
+    vel = integrate(acc, dt, cutoff_hz)
+    disp = integrate(vel, dt, cutoff_hz)
     return StrapdownMotion(time_s=t, rates=w, rate_dot=wdot, euler=np.stack([phi, th, psi], 1),
                            specific_force=f_c, acceleration=acc, velocity=vel, displacement=disp,
                            iterations=it)
