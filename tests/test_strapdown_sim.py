@@ -82,7 +82,7 @@ def test_periodic_and_non_periodic_records(f0, periodic):
 def test_mirror_integration_on_non_periodic_records(f0):
     """The time-domain integration with a mirror-extended zero-phase high-pass (integration="mirror")
     does not need a whole number of cycles: pitch NRE < 2 % whatever the record length (measured
-    1.3–1.7 %; the FFT integration: 0.3 % periodic, 3.9–12.5 % not)."""
+    1.3–1.9 %; the FFT integration: 0.3 % periodic, 3.9–12.5 % not)."""
     cols, th = _pitching(f0)
     dev = _ideal_array()
     t, ch = dev.process(cols)
