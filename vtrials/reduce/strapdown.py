@@ -30,9 +30,8 @@ FFT integration (``integration="fft"``, the default) treats the record as period
 random-phase simulations are): on a record whose frequencies are off the record's own grid the measured
 NRE of roll/pitch/yaw was 2.4–17 % at 5° RMS (vs < 0.1 % periodic). ``integration="mirror"``
 (:func:`mirror_integrate`: trapezoidal integration in time, a line removed, a zero-phase high-pass on
-the mirror-extended record) needs no periodicity: 0.8–1.4 % on that record (15° RMS: 1.2–2.2 %, FFT
-8–19 %); on a periodic record it is
-less exact than the FFT (15° RMS: 2.0–2.4 % against 1.0–1.6 %), so use it for measured records.
+the mirror-extended record) needs no periodicity: 0.8–1.4 % on that record (15° RMS: 1.2–2.2 %,
+FFT 8–19 %); on a periodic record it is less exact than the FFT (15° RMS: 2.0–2.4 % against 1.0–1.6 %), so use it for measured records.
 :func:`suggest_cutoff` chooses the cut-off from the readings (0.2 × the angular accelerations'
 spectral peak). The high-pass cut-off keeps low-frequency noise from being amplified (Miles:
 "FC"); motion below it is lost — the method is for oscillatory motion, not for manoeuvres.
