@@ -7,7 +7,8 @@
   integrations treat the record as periodic; the "mirror" integration (time domain, detrended,
   mirror-extended zero-phase high-pass) keeps such a record under 2 %;
 * a short record of patrol51 in a quartering sea (benchmarks/strapdown_sim.py, 200 s): roll of several
-  degrees RMS reconstructed within the measured NRE, and the nonlinear scheme beats Miles' linearised
+  degrees RMS reconstructed within the measured NRE (the mirror integration well under the FFT's), and
+  the nonlinear scheme beats Miles' linearised
   analysis (his claim) — by a factor > 2 on pitch.
 Measured figures over longer records: benchmarks/results/strapdown_sim.json.
 """
@@ -99,6 +100,9 @@ def test_strapdown_on_a_short_simulated_record():
     rec = S.simulate_array(3.0, 7.0, 120.0, 10.0, 200.0, n_components=60)
     r = S.reconstruct(rec)
     assert r["rms_roll"] > 5.0                       # a large roll: the nonlinear terms matter
+    # the mirror integration (default) against the periodic FFT integration on this non-periodic record:
+    # measured roll NRE 4.6 % vs 8.1 % (12.8° RMS)
+    assert r["nre_roll_pct"] < 0.7 * S.reconstruct(rec, integration="fft")["nre_roll_pct"]
     assert r["nre_roll_pct"] < 10.0 and r["nre_pitch_pct"] < 10.0 and r["nre_heave_pct"] < 20.0
     t = rec["t"]
     lin = strapdown_linear(np.linspace(t[0], t[-1], t.size), rec["acc"], AccelerometerArray(rec["offsets"], rec["axes"]), 0.04)
