@@ -563,9 +563,21 @@ class Crew:
         self.settle(run, att)
         if placed:
             self.reach_comex_point(run, att)
+        self.measure_straight(run, att, run.heading)
+        ref = window_truth(self.recent_truth(), att.t_execute, att.t_finex)
+        ref.update({"run": run.number, "attempt": attempt})
+        self.truth_refs.append(ref)
+        self._runs_done += 1
+        self.attempts.append(att)
+        return att
+
+    def measure_straight(self, run: Run, att: Attempt, course: float) -> None:
+        """The measured part of a straight run, once settled on ``course``: the settings ordered,
+        COMEX, the approach, EXECUTE, the run held for its duration, FINEX, and the director's verdict
+        on its steadiness (a measured-course run and a seakeeping leg alike)."""
         att.rpm_ordered = [x / RPM for x in self.rps_order]
         att.pitch_ordered = [x if self._cp[k] else None for k, x in enumerate(self.pitch_order)]
-        self.hold(run.heading, run.helm_limit)
+        self.hold(course, run.helm_limit)
         att.t_comex = self.t
         self.events.append((self.t, run.number, EV_COMEX))
         self.advance(self.rules.approach_s)
@@ -574,14 +586,8 @@ class Crew:
         self.advance(run.duration)
         att.t_finex = self.t
         self.events.append((self.t, run.number, EV_FINEX))
-        ok, why = judge(self.display(att.t_execute), run.heading, self.st, run.modes, self._torque_floor)
-        att.run_steady, att.run_notes = ok, why
-        ref = window_truth(self.recent_truth(), att.t_execute, att.t_finex)
-        ref.update({"run": run.number, "attempt": attempt})
-        self.truth_refs.append(ref)
-        self._runs_done += 1
-        self.attempts.append(att)
-        return att
+        att.run_steady, att.run_notes = judge(self.display(att.t_execute), course, self.st, run.modes,
+                                              self._torque_floor)
 
     # ------------------------------------------------------------------ seakeeping legs
     def execute_seakeeping(self, run: Run, attempt: int) -> Attempt:
@@ -594,19 +600,7 @@ class Crew:
         self.set_shafts(run)
         self.come_to(course, run.helm_limit)
         self.settle(run, att)
-        att.rpm_ordered = [x / RPM for x in self.rps_order]
-        att.pitch_ordered = [x if self._cp[k] else None for k, x in enumerate(self.pitch_order)]
-        self.hold(course, run.helm_limit)
-        att.t_comex = self.t
-        self.events.append((self.t, run.number, EV_COMEX))
-        self.advance(self.rules.approach_s)
-        att.t_execute = self.t
-        self.events.append((self.t, run.number, EV_EXECUTE))
-        self.advance(run.duration)
-        att.t_finex = self.t
-        self.events.append((self.t, run.number, EV_FINEX))
-        ok, why = judge(self.display(att.t_execute), course, self.st, run.modes, self._torque_floor)
-        att.run_steady, att.run_notes = ok, why
+        self.measure_straight(run, att, course)
         cols = self.recent_truth()
         ref = window_truth(cols, att.t_execute, att.t_finex)
         ref.update(SK.leg_truth(cols, att.t_execute, att.t_finex, SK.motion_site(self.iset)))
