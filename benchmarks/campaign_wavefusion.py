@@ -43,7 +43,7 @@ from vtrials.reduce.shipbuoy import ship_buoy_from_record
 from vtrials.reduce.wavefusion import fuse_run
 from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 from vtrials.scenario import load_scenario, wave_field
-from vtrials.truth.seastate import sea_truth, window_heading
+from vtrials.truth.seaway import sea_truth, window_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "campaign_wavefusion.json"

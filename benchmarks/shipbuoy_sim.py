@@ -6,7 +6,7 @@ s = 10) and the wind from ``direction``: from 010 the sea meets the 045 leg 35 d
 the 225 leg on the starboard quarter; from 080 the mirror images. Per run the reduction reads the record
 only (IMU specific forces and vertical-gyro roll/pitch -> heave at the IMU, roll, pitch; cross-spectra;
 fit with the team's DESIGN-STAGE RAOs, models/patrol51/design) and is scored against the true sea
-(vtrials.truth.seastate: the components' H_s, their energy-weighted mean direction relative to the
+(vtrials.truth.seaway: the components' H_s, their energy-weighted mean direction relative to the
 ship's true mean heading over the run). Two fit settings are reported: roll RAO trusted, and roll with
 a free gain.
 
@@ -34,7 +34,7 @@ from vtrials.reduce.seamotion import run_windows
 from vtrials.reduce.shipbuoy import ship_buoy_from_record
 from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 from vtrials.scenario import load_scenario, wave_field
-from vtrials.truth.seastate import sea_truth, window_heading
+from vtrials.truth.seaway import sea_truth, window_heading
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "scenarios" / "patrol51_standardization_sea3.toml"

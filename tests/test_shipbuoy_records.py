@@ -1,5 +1,5 @@
 """Wave estimation from a simulated trial record (issue 13 part C), reading the record only and the team's
-DESIGN-STAGE RAOs (models/patrol51/design), scored against the true sea (vtrials.truth.seastate).
+DESIGN-STAGE RAOs (models/patrol51/design), scored against the true sea (vtrials.truth.seaway).
 
 One short seakeeping leg of patrol51 (7 min at 8 kn, waves from the port quarter, H_s 1.5 m, cos-2s s = 10)
 with the X-band wave radar at its TRIAL calibration (reads 1.51× the sea on average, seed 004):
@@ -28,7 +28,7 @@ from vtrials.reduce.shipbuoy import ship_buoy_from_record
 from vtrials.reduce.wavefusion import fuse_run
 from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 from vtrials.scenario import load_scenario, wave_field
-from vtrials.truth.seastate import sea_truth, window_heading
+from vtrials.truth.seaway import sea_truth, window_heading
 
 LEG = """
 [scenario]

@@ -46,6 +46,11 @@ def band_truth(field, omega_lo: float = 0.0, omega_hi: float = math.inf, bins=No
         c = field.components[np.isin(k, grid)]
     else:
         c = field.components[_band(field, omega_lo, omega_hi)]
+    return _moments(c)
+
+
+def _moments(c: np.ndarray) -> dict:
+    """H_s, first-moment mean direction (towards) and circular spread σ₁ of components (n, 6)."""
     e = 0.5 * c[:, 0] ** 2
     m0 = float(np.sum(e))
     if m0 <= 0.0:
@@ -53,6 +58,29 @@ def band_truth(field, omega_lo: float = 0.0, omega_hi: float = math.inf, bins=No
     z = complex(np.sum(e * c[:, 3]), np.sum(e * c[:, 4])) / m0
     return {"hs_m": 4.0 * math.sqrt(m0), "mean_direction_to": math.atan2(z.imag, z.real) % TWO_PI,
             "spread": math.sqrt(2.0 * (1.0 - min(1.0, abs(z)))), "m0": m0}
+
+
+def sea_truth(components, heading: float | None = None) -> dict:
+    """The whole stationary sea of components (n, 6) [a, ω, k, cos μ, sin μ, ε] (μ towards, from north):
+    {"hs", "mean_to" [rad], "spread" [rad]} by the definitions above, and with ``heading`` [rad] (the
+    ship's true mean heading over a run, :func:`window_heading`): "mu_rel" (towards, relative to the
+    heading, (−π, π]) and "from_rel_deg" (where the waves come from relative to the bow, + starboard) —
+    what ship-as-a-wave-buoy and wave fusion are scored against."""
+    m = _moments(np.asarray(components, dtype=float))
+    out = {"hs": m["hs_m"], "mean_to": m["mean_direction_to"], "spread": m["spread"]}
+    if heading is not None:
+        mu_rel = math.remainder(out["mean_to"] - heading, TWO_PI)
+        out["mu_rel"] = mu_rel
+        out["from_rel_deg"] = math.degrees(math.remainder(mu_rel + math.pi, TWO_PI))
+    return out
+
+
+def window_heading(t, heading, t0: float, t1: float) -> float:
+    """Circular mean of the true heading [rad] over t0 ≤ t ≤ t1."""
+    t = np.asarray(t, dtype=float)
+    h = np.asarray(heading, dtype=float)
+    k = (t >= t0) & (t <= t1)
+    return math.atan2(float(np.mean(np.sin(h[k]))), float(np.mean(np.cos(h[k])))) % TWO_PI
 
 
 def window_hs(field, north, east, t0: float, t1: float, rate_hz: float = 4.0) -> float:
