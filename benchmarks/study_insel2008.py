@@ -75,16 +75,21 @@ def load_case(out: Path, n: int) -> dict:
     reps = {}
     for i in range(n):
         r = json.loads((out / "parts" / f"replicate_{i:05d}.json").read_text())
-        err = {}
+        err, runs = {}, {}
         for row in r["rows"]:
             q = row["quantity"]
+            if "/runs[run=" in q and row["truth"]:
+                k = int(q.split("run=")[1].split("]")[0])
+                name = q.rsplit("/", 1)[1]
+                runs.setdefault(k, {})[name] = row["error"] / (row["truth"] if name == "power_measured" else 1.0)
+                continue
             if "/spots[group=" not in q:
                 continue
             g = int(q.split("group=")[1].split("]")[0])
             name = q.rsplit("/", 1)[1]
             if name in QUANTITIES:
                 err[(name, g)] = row["error"]
-        reps[i] = {"drawn": r["drawn"], "err": err}
+        reps[i] = {"drawn": r["drawn"], "err": err, "runs": runs}
     return reps
 
 
@@ -136,6 +141,25 @@ def budget(cases: dict) -> dict:
     return out
 
 
+def run_level(case: dict) -> dict:
+    """Run-level measurement errors of a campaign split into the part common to a trial's runs (per
+    replicate mean: calibration draws, a bias for the trial) and the run-to-run part (deviations from it:
+    precision in the narrow sense): RMS of each, for shaft power (relative) and speed over ground."""
+    out = {}
+    for name, scale, unit in (("power_measured", 100.0, "%"), ("sog", 1.0 / KN, "kn")):
+        common, dev = [], []
+        for r in case.values():
+            e = np.array([v[name] for v in r["runs"].values() if name in v]) * scale
+            if e.size >= 2:
+                common.append(float(np.mean(e)))
+                dev += list(e - np.mean(e))
+        n_run = np.mean([len(r["runs"]) for r in case.values()]) if case else 0
+        out[name] = {"unit": unit, "common_rms": float(np.sqrt(np.mean(np.square(common)))) if common else math.nan,
+                     "run_to_run_rms": float(np.sqrt(np.sum(np.square(dev)) / max(len(dev) - len(common), 1)))
+                     if dev else math.nan, "runs_per_trial": float(n_run)}
+    return out
+
+
 def findings(b: dict) -> list[dict]:
     q = "power_at_equal_speed"
     bs = b[q]
@@ -165,7 +189,7 @@ def _f(x, nd=2):
     return "—" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{nd}f}"
 
 
-def report(b: dict, finds: list[dict], reps: dict) -> str:
+def report(b: dict, finds: list[dict], reps: dict, run_lv: dict | None = None) -> str:
     L = ["# Study: Insel (2008) — error budget of a speed/power trial, one source at a time", "",
          "Reproduces the qualitative findings of M. Insel, \"Uncertainty in the analysis of speed and powering "
          "trials\", *Ocean Engineering* 35 (2008) 1183–1193, with vtrials campaigns (`benchmarks/study_insel2008.py`).",
@@ -213,6 +237,12 @@ def report(b: dict, finds: list[dict], reps: dict) -> str:
                              f"[{_f(e['lo95'], 3 if unit == 'kn' else 2)}, {_f(e['hi95'], 3 if unit == 'kn' else 2)}] "
                              f"(n {e['n']})")
             L.append(f"| {k} | " + " | ".join(cells) + " |")
+    if run_lv:
+        L += ["", "## What the precision case is made of (run-level errors of the precision campaign)", "",
+              "| Measurement | common to a trial's runs (calibration draws) RMS | run to run RMS |", "|---|---|---|"]
+        for name, label in (("power_measured", "shaft power (relative)"), ("sog", "speed over ground")):
+            e = run_lv[name]
+            L.append(f"| {label} [{e['unit']}] | {_f(e['common_rms'], 3)} | {_f(e['run_to_run_rms'], 3)} |")
     L.append("")
     return "\n".join(L)
 
@@ -243,10 +273,12 @@ def main(argv=None) -> int:
     doc = {"study": "Insel 2008, Ocean Engineering 35:1183-1193",
            "scenarios": {c: str(p.relative_to(ROOT)) for c, p in CASES.items()}, "replicates": nrep,
            "budget": {q: {str(g): v for g, v in d.items()} for q, d in b.items()}, "findings": finds,
-           "replicate_errors": {c: {str(i): {"drawn": r["drawn"], "err": {f"{k[0]}[{k[1]}]": v for k, v in r["err"].items()}}
+           "precision_run_level": run_level(cases["precision"]) if "precision" in cases else None,
+           "replicate_errors": {c: {str(i): {"drawn": r["drawn"], "err": {f"{k[0]}[{k[1]}]": v for k, v in r["err"].items()}, "runs": r["runs"]}
                                     for i, r in reps.items()} for c, reps in cases.items()}}
     (out / "insel2008.json").write_text(json.dumps(json_clean(doc), indent=1))
-    (out / "insel2008.md").write_text(report(b, finds, nrep))
+    run_lv = run_level(cases["precision"]) if "precision" in cases else None
+    (out / "insel2008.md").write_text(report(b, finds, nrep, run_lv))
     for f in finds:
         print(("REPRODUCED " if f["reproduced"] else "NOT REPRODUCED ") + f["finding"])
     return 0
