@@ -124,3 +124,23 @@ def test_bootstrap_rms_interval_contains_the_rms():
     assert r["lo95"] < r["rms"] < r["hi95"] and r["rms"] == pytest.approx(0.1, rel=0.15)
     d = ST.paired_rms_difference(2 * e, e)
     assert d["lo95"] > 0
+
+
+@pytest.mark.parametrize("name", ["patrol51_strasser_semidiurnal", "patrol51_strasser_departing",
+                                  "patrol51_insel_precision", "patrol51_insel_wind", "patrol51_insel_current"])
+def test_study_scenarios_load_as_campaigns(name):
+    from pathlib import Path
+
+    from vtrials.campaign.spec import load_campaign, replicate_doc, replicate_seeds
+    from vtrials.scenario import load_scenario
+    path = str(Path(__file__).resolve().parent.parent / "scenarios" / "studies" / f"{name}.toml")
+    spec = load_campaign(path)
+    doc, drawn = replicate_doc(spec, replicate_seeds(spec.seed, spec.replicates)[0])
+    scn = load_scenario(path, doc)
+    runs = scn.agenda.trials[0].runs
+    per_spot = [sum(r.group == g for r in runs) for g in (1, 2, 3)]
+    assert per_spot == ([4, 4, 4] if "strasser" in name else [2, 2, 2])
+    assert len(runs) == sum(per_spot)
+    if "strasser" in name:
+        assert 0.0 <= drawn["environment.current.tidal_phase_deg"] < 360.0
+        assert scn.current.tidal_period_h == (12.42 if "semidiurnal" in name else 1.0)
