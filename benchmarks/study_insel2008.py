@@ -260,6 +260,26 @@ def report(b: dict, finds: list[dict], reps: dict, run_lv: dict | None = None) -
                              f"[{_f(e['lo95'], 3 if unit == 'kn' else 2)}, {_f(e['hi95'], 3 if unit == 'kn' else 2)}] "
                              f"(n {e['n']})")
             L.append(f"| {k} | " + " | ".join(cells) + " |")
+    bp, raw = b["power_at_equal_speed"], b.get("power_uncorrected")
+    L += ["", "## Reading", "",
+          f"* Precision (calm water: instrument noise and calibration draws, helm, run-to-run unsteadiness) gives "
+          f"{_f(bp[1]['precision']['u'])} % of power at equal speed at the low spot against "
+          f"{_f(bp[3]['precision']['u'])} % at the top: the same absolute errors of torque and speed weigh more "
+          "against a small power at low speed."]
+    if raw and "wind Bf 0–6" in raw[1]:
+        L.append(f"* Wind as it enters the data is the largest environmental source (before the correction: "
+                 f"{_f(raw[1]['wind Bf 0–6']['u'])} % at the low spot over Bf 0–6, {_f(raw[1].get('wind Bf 5–6', {}).get('u'))} % "
+                 f"at Bf 5–6), but the reduction's direct power method — fed by the measured relative wind and the "
+                 f"ship's own windage coefficients — removes it to within the scatter (after the correction: "
+                 f"{_f(bp[1]['wind Bf 0–6']['u'])} %). A correction resting on a coarser wind estimate (an observed "
+                 "Beaufort number) may leave more of the raw contribution: that is where our result and the paper's "
+                 "can part.")
+    if "current 0–1 kn" in bp[1]:
+        L.append(f"* A tidal stream of up to 1 kn, removed by one double run per spot with the reduction's trend "
+                 f"correction, adds {_f(bp[1]['current 0–1 kn']['u'])} / {_f(bp[2]['current 0–1 kn']['u'])} / "
+                 f"{_f(bp[3]['current 0–1 kn']['u'])} % (low / middle / top spot).")
+    L.append("* Negative entries: the source's campaign scattered less than the precision campaign for the same "
+             "replicate seeds — within the sampling noise of a difference of two scatters.")
     if run_lv:
         L += ["", "## What the precision case is made of (run-level errors of the precision campaign)", "",
               "| Measurement | common to a trial's runs (calibration draws) RMS | run to run RMS |", "|---|---|---|"]

@@ -202,7 +202,8 @@ def report(summ: dict, finds: list[dict], meta: dict) -> str:
          "* Methods: **MoM** = textbook mean of means per spot (two-run average for one double run, "
          "(V₁+3V₂+3V₃+V₄)/8 for two); **iterative** = ITTC 7.5-04-01-01.1 / ISO 15016:2015 iterative method over "
          "all kept runs (P = a + bV^q with the semidiurnal current model V_C,C cos + V_C,S sin + V_C,T t + V_C,0; "
-         "with only 6 runs the model falls back to a constant current, as the reduction does); its spot speed is "
+         "with only 6 runs the model falls back to a constant current, as the reduction does, and its spot speeds are then "
+         "exactly the two-run averages); its spot speed is "
          "the heading-balanced mean of the spot's runs.",
          "* Score: error of each spot's speed through water against its true heading-balanced mean speed "
          "through water over the same runs (vtrials.score.trials.spot_stw_truth). Errors in knots; RMS with "
