@@ -219,7 +219,8 @@ def report(b: dict, finds: list[dict], reps: dict, run_lv: dict | None = None) -
          "* Campaigns sharing one campaign seed (replicate i has the same scenario seed in all: paired "
          f"differences): precision {reps.get('precision', 0)} replicates (calm water, no wind, no current); wind "
          f"{reps.get('wind', 0)} (Beaufort 0–6: 0–27 kn uniform, direction uniform, NPD gusts); current "
-         f"{reps.get('current', 0)} (semidiurnal stream 0–1 kn, axis and phase uniform).",
+         f"{reps.get('current', 0)} (semidiurnal stream 0–1 kn, axis and phase uniform). A source's budget uses the "
+         "replicates its campaign shares with the precision campaign (n in the tables).",
          "* Reduction: the operational one from the records (mean of means per spot with the two-run trend "
          "correction; wind by the direct power method from the measured relative wind). Score: the campaign's "
          "(vtrials.score.trials) — power at equal speed relative to the true calm-water curve, speed through "
