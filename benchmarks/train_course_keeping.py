@@ -49,7 +49,7 @@ def _stats(errs: np.ndarray, meas: np.ndarray) -> dict:
             "true_mean": math.degrees(float(np.mean(e))), "measured_mean": math.degrees(float(np.mean(m)))}
 
 
-def evaluate(model_or_pid, seeds, sea: str, integral: bool = False) -> list[dict]:
+def evaluate(model_or_pid, seeds, sea: str, integral: bool = False, norm=None) -> list[dict]:
     """Heading-error statistics [deg] of one episode per seed, over the last two thirds of each episode:
     ``true`` (RMS of the true heading error), ``dynamic`` (its standard deviation about the episode
     mean), ``measured`` (RMS of the gyrocompass heading error the controller sees) and the two means.
@@ -68,7 +68,8 @@ def evaluate(model_or_pid, seeds, sea: str, integral: bool = False) -> list[dict
         pid.reset()
         act = lambda obs: pid()  # noqa: E731
     else:
-        act = lambda obs: model_or_pid.predict(obs, deterministic=True)[0]  # noqa: E731
+        def act(obs):
+            return model_or_pid.predict(obs if norm is None else norm.normalize_obs(obs), deterministic=True)[0]
     steps = core.task_steps()
     live = np.ones(n, dtype=bool)
     errs, meas, alive = [], [], []
@@ -180,6 +181,8 @@ def main(argv=None):
     ap.add_argument("--sea", default="wind_current")
     ap.add_argument("--integral", action="store_true",
                     help="observe the integral of the measured heading error (task option heading_integral)")
+    ap.add_argument("--normalize", action="store_true",
+                    help="running normalisation of observations and rewards (SB3 VecNormalize, saved with the model)")
     ap.add_argument("--eval-every", type=int, default=200_000, help="timesteps between curve points")
     ap.add_argument("--curve-seeds", type=int, default=20, help="held-out seeds of each curve point")
     ap.add_argument("--eval-seeds", type=int, default=200, help="unseen seeds in the final comparison")
@@ -201,8 +204,14 @@ def main(argv=None):
     if a.evaluate:
         model = PPO.load(a.evaluate, device="cpu")
         integral = model.observation_space.shape[0] == 13  # 9 common + 3 task features (+ 1 integral)
+        norm = None
+        npath = Path(a.evaluate).with_name("vecnormalize.pkl")
+        if npath.exists():
+            import pickle
+            with open(npath, "rb") as f:
+                norm = pickle.load(f)
         t1 = time.perf_counter()
-        ppo, pid = evaluate(model, seeds, a.sea, integral), evaluate("pid", seeds, a.sea)
+        ppo, pid = evaluate(model, seeds, a.sea, integral, norm), evaluate("pid", seeds, a.sea)
         st = paired(ppo, pid)
         (out / "evaluation.json").write_text(json.dumps({"model": str(a.evaluate), "sea": a.sea, "integral": integral,
                                                          "eval_seeds": [seeds[0], seeds[-1]],
@@ -212,6 +221,10 @@ def main(argv=None):
         return
 
     venv = batch_vec_env(a.n_envs, a.sea, a.integral, a.seed)
+    norm = None
+    if a.normalize:
+        from stable_baselines3.common.vec_env import VecNormalize
+        venv = norm = VecNormalize(venv, norm_obs=True, norm_reward=True, clip_obs=10.0, gamma=0.99)
     model = PPO("MlpPolicy", venv, n_steps=a.n_steps, batch_size=a.batch_size, n_epochs=10, learning_rate=3e-4,
                 gamma=0.99, gae_lambda=0.95, clip_range=0.2, ent_coef=0.0, seed=a.seed, verbose=0, device="cpu",
                 policy_kwargs={"net_arch": [64, 64]})
@@ -230,7 +243,7 @@ def main(argv=None):
     while time.perf_counter() < deadline:
         model.learn(a.eval_every, reset_num_timesteps=False, callback=Stop())
         done = model.num_timesteps
-        r = evaluate(model, curve_seeds, a.sea, a.integral)
+        r = evaluate(model, curve_seeds, a.sea, a.integral, norm)
         curve.append({"timesteps": done, "minutes": (time.perf_counter() - t0) / 60,
                       "true_rms_deg": float(np.mean([x["true"] for x in r])),
                       "measured_rms_deg": float(np.mean([x["measured"] for x in r])),
@@ -240,14 +253,16 @@ def main(argv=None):
               f"{c['measured_rms_deg']:.3f} deg (load {c['load_1min']:.1f})", flush=True)
     train_min = (time.perf_counter() - t0) / 60.0
     model.save(out / "model")
+    if norm is not None:
+        norm.save(out / "vecnormalize.pkl")
     t1 = time.perf_counter()
-    ppo = evaluate(model, seeds, a.sea, a.integral)
+    ppo = evaluate(model, seeds, a.sea, a.integral, norm)
     pid = evaluate("pid", seeds, a.sea)
     eval_min = (time.perf_counter() - t1) / 60.0
     st = paired(ppo, pid)
     pid_c = {k: float(np.mean([x[k] for x in pid_curve])) for k in ("true", "measured")}
     summary = {"timesteps": done, "train_minutes": train_min, "n_envs": a.n_envs, "n_steps": a.n_steps,
-               "batch_size": a.batch_size, "integral": a.integral, "sea": a.sea, "torch_threads": 1,
+               "batch_size": a.batch_size, "integral": a.integral, "normalize": a.normalize, "sea": a.sea, "torch_threads": 1,
                "load_1min_during_training": [c["load_1min"] for c in curve], "eval_minutes": eval_min,
                "eval_seeds": [seeds[0], seeds[-1]], "paired": st,
                "curve": curve, "curve_seeds": [curve_seeds[0], curve_seeds[-1]], "pid_on_curve_seeds_deg": pid_c,
