@@ -262,7 +262,8 @@ def main(argv=None):
     st = paired(ppo, pid)
     pid_c = {k: float(np.mean([x[k] for x in pid_curve])) for k in ("true", "measured")}
     summary = {"timesteps": done, "train_minutes": train_min, "n_envs": a.n_envs, "n_steps": a.n_steps,
-               "batch_size": a.batch_size, "integral": a.integral, "normalize": a.normalize, "sea": a.sea, "torch_threads": 1,
+               "batch_size": a.batch_size, "integral": a.integral, "normalize": a.normalize, "sea": a.sea,
+               "torch_threads": 1,
                "load_1min_during_training": [c["load_1min"] for c in curve], "eval_minutes": eval_min,
                "eval_seeds": [seeds[0], seeds[-1]], "paired": st,
                "curve": curve, "curve_seeds": [curve_seeds[0], curve_seeds[-1]], "pid_on_curve_seeds_deg": pid_c,
