@@ -22,10 +22,11 @@ def markdown(doc: dict) -> str:
          f"Search: campaigns of {doc['search_replicates']} replicates, in this order: "
          + ", ".join(doc["search_order"]) + f". Surrogate {doc['surrogate']['model']}.", ""]
     if doc["chosen"] is None:
-        L.append("**No candidate of the family is predicted to meet the target within the limits.**")
+        L.append("**The search ended without an agenda that meets the target** (none of the family within the limits "
+                 "is predicted to, or the search was stopped first).")
     else:
         L += [f"**Chosen agenda: {doc['chosen']}** — one step cheaper: {doc['one_step_cheaper'] or 'none'}.", "",
-              f"| agenda | trial time predicted / simulated [h] | {100 * tg['confidence']:g} % quantile of |error| "
+              f"| agenda | trial time predicted / simulated [h] | {100 * tg['confidence']:g} % quantile of abs(error) "
               f"predicted / search / verified [{u}] | fraction within ±{tg['tolerance']:g} {u} (verified, Wilson 95 %) "
               f"| meets (verified) |",
               "|---|---|---|---|---|"]
@@ -39,6 +40,10 @@ def markdown(doc: dict) -> str:
                      f"{_f(s and s['quantile_abs_error'])} / {r['quantile_abs_error']:.4f} | "
                      f"{r['within']}/{r['n']} = {r['fraction']:.3f} [{r['wilson_lo']:.3f}, {r['wilson_hi']:.3f}] | "
                      f"{'yes' if r['meets'] else 'no'} |")
+        L += ["", f"Verified errors: " + "; ".join(
+            f"{v['candidate']['name']}: mean {v['verified']['mean_error']:+.4f} {u}, rms {v['verified']['rms_error']:.4f} {u}"
+            + (f" (surrogate rms {v['predicted']['mse'] ** 0.5:.4f} {u})" if v.get("predicted") else "")
+            for v in doc["verification"].values()) + "."]
         a = doc["acceptance"]
         L += ["", f"Verified with {doc['verify_replicates']} replicates (independent seed): chosen meets the target: "
                   f"{a['chosen_meets']}; the one-step-cheaper agenda fails it: {a['cheaper_fails']}."]
