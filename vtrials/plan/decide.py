@@ -19,10 +19,13 @@ Surrogate (the search's prediction between campaigns): the mean squared error of
 
 — a floor per pattern (what current elimination and the all-runs analysis leave: it depends on how
 many runs, how far apart, not on their length) plus the instruments' noise averaged over the measured
-time at the target spot — fitted by non-negative least squares to the search campaigns. With
-errors taken as normal, the predicted fraction within ±tol is erf(tol / √(2 MSE)) and the predicted
-confidence-quantile of |e| is z·√MSE, z = Φ⁻¹((1 + confidence)/2). Both are reported beside the
-campaigns' own numbers.
+time at the target spot — fitted by non-negative least squares to the search campaigns. The shape of
+the error distribution comes from the campaigns too (``shape = "empirical"``, the default): the pooled
+|e|/√MSE of every search replicate, each campaign scaled by its own MSE; the predicted fraction
+within ±tol is the fraction of that pool within tol/√MSE, the predicted confidence-quantile of |e| its
+quantile times √MSE. With ``shape = "normal"`` the errors are taken as normal instead: erf(tol/√(2 MSE))
+and z·√MSE, z = Φ⁻¹((1 + confidence)/2) — conservative when the errors' tails are lighter than a
+normal's. Both are reported beside the campaigns' own numbers.
 """
 
 from __future__ import annotations
@@ -60,19 +63,38 @@ def meets(stats_: dict, confidence: float, rule: str) -> bool:
     return stats_["within"] >= confidence * stats_["n"] - 1e-9
 
 
-def predicted_fraction(mse: float, tolerance: float) -> float:
-    """P(|e| ≤ tol) for e ~ N(0, mse)."""
+def error_shape(campaigns) -> np.ndarray:
+    """The pooled shape of the error distribution: |e|/√MSE of every replicate of every campaign
+    (``campaigns``: (errors, mse) pairs; a replicate without the quantity is +inf), sorted."""
+    z = []
+    for errs, mse in campaigns:
+        e = np.abs(np.asarray(errs, dtype=float))
+        if not (math.isfinite(mse) and mse > 0):
+            continue
+        z.append(np.where(np.isfinite(e), e / math.sqrt(mse), np.inf))
+    return np.sort(np.concatenate(z)) if z else np.zeros(0)
+
+
+def predicted_fraction(mse: float, tolerance: float, shape: np.ndarray | None = None) -> float:
+    """P(|e| ≤ tol) for errors of mean square ``mse``: normal (``shape`` None), or distributed like
+    the pooled campaigns' ``shape`` (:func:`error_shape`) scaled to √mse."""
     if mse <= 0:
         return 1.0
-    return float(special.erf(tolerance / math.sqrt(2.0 * mse)))
+    if shape is None or shape.size == 0:
+        return float(special.erf(tolerance / math.sqrt(2.0 * mse)))
+    return float(np.mean(shape <= tolerance / math.sqrt(mse)))
 
 
-def predicted_quantile(mse: float, confidence: float) -> float:
-    return float(stats.norm.ppf(0.5 * (1.0 + confidence)) * math.sqrt(max(mse, 0.0)))
+def predicted_quantile(mse: float, confidence: float, shape: np.ndarray | None = None) -> float:
+    if shape is None or shape.size == 0:
+        return float(stats.norm.ppf(0.5 * (1.0 + confidence)) * math.sqrt(max(mse, 0.0)))
+    k = min(shape.size - 1, max(0, math.ceil(confidence * shape.size) - 1))
+    return float(shape[k] * math.sqrt(max(mse, 0.0)))
 
 
-def predicted_meets(mse: float, tolerance: float, confidence: float, rule: str, n_verify: int) -> bool:
-    p = predicted_fraction(mse, tolerance)
+def predicted_meets(mse: float, tolerance: float, confidence: float, rule: str, n_verify: int,
+                    shape: np.ndarray | None = None) -> bool:
+    p = predicted_fraction(mse, tolerance, shape)
     if rule == "wilson":
         return wilson(int(round(p * n_verify)), n_verify)[0] >= confidence
     return p >= confidence

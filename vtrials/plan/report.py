@@ -20,7 +20,10 @@ def markdown(doc: dict) -> str:
          + (f", wind ≤ {doc['limits']['max_wind_kn']:g} kn" if doc['limits']['max_wind_kn'] is not None else "") + ".",
          "Site climate (drawn per replicate): " + "; ".join(f"{k} {v}" for k, v in doc["climate"].items()) + ".",
          f"Search: campaigns of {doc['search_replicates']} replicates, in this order: "
-         + ", ".join(doc["search_order"]) + f". Surrogate {doc['surrogate']['model']}.", ""]
+         + ", ".join(doc["search_order"]) + f". Surrogate {doc['surrogate']['model']}, error shape "
+         + (f"empirical ({100 * tg['confidence']:g} % quantile of |e|/√MSE = {doc['surrogate']['shape_quantile']:.3f} "
+            f"from {doc['surrogate']['shape_pool']} search replicates; 1.960 for normal errors)"
+            if doc["surrogate"].get("shape_quantile") is not None else "normal") + ".", ""]
     if doc["chosen"] is None:
         L.append("**The search ended without an agenda that meets the target** (none of the family within the limits "
                  "is predicted to, or the search was stopped first).")

@@ -65,6 +65,7 @@ class Planner:
         if not self.cands:
             raise InputError(spec.path, "limits.max_hours", f"no candidate agenda fits in {spec.max_hours:g} h")
         self.search: dict[str, dict] = {}
+        self.shape = None
         self.order_run: list[str] = []
 
     def campaign(self, cand: Candidate, phase: str, n: int, seed: int) -> dict:
@@ -90,6 +91,9 @@ class Planner:
         return res
 
     def surrogate(self) -> D.Surrogate:
+        runs = [r for r in self.search.values() if math.isfinite(r["mse"])]
+        self.shape = (D.error_shape([(r["errors"], r["mse"]) for r in runs]) if self.spec.shape == "empirical"
+                      else None)
         pts = []
         for c in self.cands:
             r = self.search.get(c.name)
@@ -103,9 +107,9 @@ class Planner:
             return None
         tg = self.spec.target
         mse = sur.mse(c.pattern, x)
-        return {"mse": mse, "fraction": D.predicted_fraction(mse, tg.tolerance),
-                "quantile_abs_error": D.predicted_quantile(mse, tg.confidence),
-                "meets": D.predicted_meets(mse, tg.tolerance, tg.confidence, tg.rule, self.n_verify)}
+        return {"mse": mse, "fraction": D.predicted_fraction(mse, tg.tolerance, self.shape),
+                "quantile_abs_error": D.predicted_quantile(mse, tg.confidence, self.shape),
+                "meets": D.predicted_meets(mse, tg.tolerance, tg.confidence, tg.rule, self.n_verify, self.shape)}
 
     def run_search(self, max_campaigns: int | None = None) -> Candidate | None:
         limit = max_campaigns or len(self.cands)
@@ -163,7 +167,10 @@ class Planner:
             "search_replicates": self.n_search, "verify_replicates": self.n_verify,
             "surrogate": {"floors": {f"spots={k[0]},runs={k[1]}": v for k, v in sur.floors.items()},
                           "slope": sur.slope, "slope_identified": sur.slope_identified,
-                          "model": "MSE = A[spots,runs] + B/(runs*run_s)"},
+                          "model": "MSE = A[spots,runs] + B/(runs*run_s)", "shape": spec.shape,
+                          "shape_quantile": (None if self.shape is None or not self.shape.size else
+                                             D.predicted_quantile(1.0, tg.confidence, self.shape)),
+                          "shape_pool": 0 if self.shape is None else int(self.shape.size)},
             "search_order": self.order_run,
             "chosen": None if chosen is None else chosen.name,
             "one_step_cheaper": None if cheaper is None else cheaper.name,

@@ -8,6 +8,8 @@
     seed = 11                                      # campaign seed of the search; verification uses seed + 1
     search_replicates = 20                         # replicates per candidate while searching
     verify_replicates = 200                        # replicates of the verifying campaigns
+    shape = "empirical"                            # the surrogate's error distribution: empirical (pooled
+                                                   # search campaigns) or normal
 
     [site]
     water_depth_m = 120.0                          # depth of the trial site (fixed; or draw it in [climate])
@@ -56,9 +58,10 @@ from vtrials.schema import load_toml
 KINDS = ("standardization",)  # trial kinds the planner has an agenda family for
 QUANTITIES = {"standardization": {"speed": "kn", "power": "%"}}
 RULES = ("quantile", "wilson")
+SHAPES = ("empirical", "normal")
 _SETTING_KEYS = ("rpm", "pitch", "order")
 _TABLES = {
-    "plan": ("kind", "scenario", "ship", "seed", "search_replicates", "verify_replicates"),
+    "plan": ("kind", "scenario", "ship", "seed", "search_replicates", "verify_replicates", "shape"),
     "site": ("water_depth_m",),
     "climate": None,
     "target": ("quantity", "tolerance", "confidence", "rule") + _SETTING_KEYS,
@@ -103,6 +106,7 @@ class PlanSpec:
     seed: int
     search_replicates: int
     verify_replicates: int
+    shape: str = "empirical"  # error-distribution shape of the surrogate: empirical (pooled campaigns) | normal
 
 
 def _num(x) -> bool:
@@ -187,6 +191,9 @@ def load_plan(path: str | Path) -> PlanSpec:
     seed = _int(f, "plan.seed", plan.get("seed", 0), 0, 2 ** 62)
     n_search = _int(f, "plan.search_replicates", plan.get("search_replicates", 20), 3, 100000)
     n_verify = _int(f, "plan.verify_replicates", plan.get("verify_replicates", 200), 3, 100000)
+    shape = plan.get("shape", "empirical")
+    if shape not in SHAPES:
+        raise InputError(f, "plan.shape", f"{shape!r}: expected one of {', '.join(SHAPES)}")
 
     site = doc.get("site", {})
     if "water_depth_m" in site:
@@ -246,7 +253,7 @@ def load_plan(path: str | Path) -> PlanSpec:
                  _pos_num(f, "candidates.setting_change_s", c.get("setting_change_s", 120.0), 0.0, 36000.0,
                           lo_open=False))
     return PlanSpec(f, kind, str(spath), base, tuple(vary), fixed, target, max_hours, max_wind, fam, seed,
-                    n_search, n_verify)
+                    n_search, n_verify, shape)
 
 
 def _limit_wind(f: str, v: Vary, max_wind: float | None) -> Vary:
