@@ -188,6 +188,14 @@ def test_tiny_plan_end_to_end(tmp_path):
     # the simulated trial time follows the agenda (2 runs; the turn time is the plan's estimate)
     assert v["simulated_time_s"] == pytest.approx(660.0, rel=0.4)
     assert "Chosen agenda: s1_r2_t30" in (out / "plan.md").read_text()
+    # assembling from the campaigns already there runs nothing and gives the same verdicts; a verifying
+    # campaign stopped short is summarized over the replicates it has
+    (out / "candidates" / "s1_r2_t30" / "verify" / "parts" / "replicate_00002.json").unlink()
+    again = plan(PLAN, out, assemble=True)
+    w = again["verification"]["chosen"]["verified"]
+    assert again["chosen"] == "s1_r2_t30" and w["n"] == 2 and w["planned_replicates"] == 3
+    assert w["errors"] == v["errors"][:2]
+    assert "stopped short" in (out / "plan.md").read_text()
 
 
 def test_cli_plan_bad_file_exits_2(tmp_path, capsys):

@@ -127,6 +127,9 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--verify-replicates", type=int, metavar="M",
                     help="replicates of each verifying campaign (default: the plan's)")
     pl.add_argument("--workers", type=int, default=1, metavar="W", help="worker processes per campaign (default 1)")
+    pl.add_argument("--assemble", action="store_true",
+                    help="run nothing: decide and report from the campaigns already in DIR (verifying campaigns "
+                         "stopped short are summarized over the replicates they have)")
     pl.add_argument("--quiet", action="store_true", help="print nothing but errors")
     ren = sub.add_parser("render", help="render a run's truth as a video",
                          description="Render the ship of RUN_DIR/truth.nc in its sea with its wake (MuJoCo, "
@@ -224,7 +227,7 @@ def _plan(args) -> int:
             raise InputError(name, "", f"must be at least {lo}")
     say = None if args.quiet else (lambda line: print(line, flush=True))
     doc = plan(args.plan, args.out, workers=args.workers, say=say, search_replicates=args.replicates,
-               verify_replicates=args.verify_replicates)
+               verify_replicates=args.verify_replicates, assemble=args.assemble)
     if not args.quiet:
         from pathlib import Path
         print(Path(args.out, "plan.md").read_text())

@@ -48,7 +48,13 @@ def markdown(doc: dict) -> str:
             + (f" (surrogate rms {v['predicted']['mse'] ** 0.5:.4f} {u})" if v.get("predicted") else "")
             for v in doc["verification"].values()) + "."]
         a = doc["acceptance"]
-        L += ["", f"Verified with {doc['verify_replicates']} replicates (independent seed): chosen meets the target: "
+        short = [f"{v['candidate']['name']} has {v['verified']['n']} of its {v['verified'].get('planned_replicates', v['verified']['n'])}"
+                 for v in doc["verification"].values()
+                 if v["verified"]["n"] < v["verified"].get("planned_replicates", v["verified"]["n"])]
+        if short:
+            L += ["", "**Verification stopped short:** " + "; ".join(short) + " planned replicates (summarized over "
+                  "the replicates run)."]
+        L += ["", f"Verified with {doc['verify_replicates']} planned replicates (independent seed): chosen meets the target: "
                   f"{a['chosen_meets']}; the one-step-cheaper agenda fails it: {a['cheaper_fails']}."]
     L += ["", "## Candidates (cheapest first)", "",
           f"| agenda | trial time [h] | predicted quantile [{u}] | predicted meets | search quantile [{u}] | search within |",

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vtrials.campaign.run import load_rows, run_campaign
+from vtrials.campaign.run import run_campaign
 from vtrials.errors import InputError
 from vtrials.plan import decide as D
 from vtrials.plan.agendas import Candidate, candidates, write_scenario
@@ -38,22 +38,27 @@ from vtrials.units import KNOT
 _QUANTITY = {"speed": ("stw", 1.0 / KNOT), "power": ("power_at_equal_speed", 100.0)}
 
 
-def target_errors(out_dir: Path, n: int, kind: str, group: int, quantity: str) -> tuple[list[float], list[float]]:
-    """Errors of the target quantity per replicate (NaN where a replicate did not give it) in the
-    target's unit, and the simulated trial time per replicate [s]."""
+def target_errors(out_dir: Path, n: int | list[int], kind: str, group: int,
+                  quantity: str) -> tuple[list[float], list[float]]:
+    """Errors of the target quantity per replicate (replicates 0..n−1, or the listed ones; NaN where a
+    replicate did not give it) in the target's unit, and the simulated trial time per replicate [s]."""
     key, scale = _QUANTITY[quantity]
-    rows, _ = load_rows(out_dir, n)
     q = f"{kind}/spots[group={group}]/{key}"
-    by = {r["replicate"]: r["error"] * scale for r in rows if r["quantity"] == q}
-    errs = [by.get(i, math.nan) for i in range(n)]
-    sim = [json.loads((Path(out_dir) / "parts" / f"replicate_{i:05d}.json").read_text()).get("simulated_time_s")
-           for i in range(n)]
-    return errs, [math.nan if s is None else float(s) for s in sim]
+    errs, sim = [], []
+    for i in (range(n) if isinstance(n, int) else n):
+        r = json.loads((Path(out_dir) / "parts" / f"replicate_{i:05d}.json").read_text())
+        e = [row["error"] * scale for row in r["rows"] if row["quantity"] == q]
+        errs.append(e[0] if e and e[0] is not None else math.nan)
+        s = r.get("simulated_time_s")
+        sim.append(math.nan if s is None else float(s))
+    return errs, sim
 
 
 class Planner:
     def __init__(self, spec: PlanSpec, out: Path, workers: int | None = 1, executor=None, say=None,
-                 search_replicates: int | None = None, verify_replicates: int | None = None):
+                 search_replicates: int | None = None, verify_replicates: int | None = None,
+                 assemble: bool = False):
+        self.assemble = assemble  # run nothing: summarize the campaigns already in ``out`` (maybe partial)
         self.spec = spec
         self.out = out
         self.workers = workers
@@ -71,16 +76,29 @@ class Planner:
     def campaign(self, cand: Candidate, phase: str, n: int, seed: int) -> dict:
         d = self.out / "candidates" / cand.name
         scen = d / "scenario.toml"
-        group = write_scenario(self.spec, cand, n, seed, scen)
         t0 = time.perf_counter()
-        self.say(f"plan: {phase} campaign of {cand.name} ({cand.describe()}), {n} replicates ...")
-        run_campaign(scen, d / phase, replicates=n, seed=seed, executor=self.executor, workers=self.workers,
-                     resume=True)
-        errs, sim = target_errors(d / phase, n, self.spec.kind, group, self.spec.target.quantity)
+        planned = n
+        if self.assemble:
+            from vtrials.plan.agendas import scenario_doc
+            group = scenario_doc(self.spec, cand, n, seed)[1]
+            parts = sorted(int(p.stem.split("_")[1]) for p in (d / phase / "parts").glob("replicate_*.json")) \
+                if (d / phase / "parts").is_dir() else []
+            parts = [i for i in parts if i < n]
+            if not parts:
+                raise InputError(str(d / phase), "--assemble", f"no replicates of the {phase} campaign of {cand.name}")
+            n = len(parts)
+        else:
+            group = write_scenario(self.spec, cand, n, seed, scen)
+            self.say(f"plan: {phase} campaign of {cand.name} ({cand.describe()}), {n} replicates ...")
+            run_campaign(scen, d / phase, replicates=n, seed=seed, executor=self.executor, workers=self.workers,
+                         resume=True)
+            parts = n
+        errs, sim = target_errors(d / phase, parts, self.spec.kind, group, self.spec.target.quantity)
         tg = self.spec.target
         st = D.empirical(errs, tg.tolerance, tg.confidence)
         fin = np.asarray([e for e in errs if math.isfinite(e)])
-        res = {"candidate": cand.name, "phase": phase, "replicates": n, "seed": seed, "target_group": group,
+        res = {"candidate": cand.name, "phase": phase, "replicates": n, "planned_replicates": planned, "seed": seed,
+               "target_group": group,
                **st, "mse": float(np.mean(fin ** 2)) if fin.size else math.inf,
                "meets": D.meets(st, tg.confidence, tg.rule),
                "simulated_time_s": float(np.nanmean(sim)), "wall_s": time.perf_counter() - t0,
@@ -199,14 +217,18 @@ def _acceptance(verify: dict) -> dict:
 
 def plan(path: str | Path, out_dir: str | Path, workers: int | None = 1, executor=None, say=None,
          search_replicates: int | None = None, verify_replicates: int | None = None,
-         max_campaigns: int | None = None) -> dict:
-    """Plan the trial of the plan file ``path``; write plan.json and plan.md to ``out_dir``."""
+         max_campaigns: int | None = None, assemble: bool = False) -> dict:
+    """Plan the trial of the plan file ``path``; write plan.json and plan.md to ``out_dir``.
+
+    ``assemble``: run no replicate; make the same decisions from the campaigns already in ``out_dir``
+    and summarize each verifying campaign over the replicates it has (a campaign stopped short, e.g.
+    at a deadline, is reported with its actual replicate count)."""
     spec = load_plan(path)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise InputError(str(out), "--out", "exists and is not a directory")
     out.mkdir(parents=True, exist_ok=True)
-    pl = Planner(spec, out, workers, executor, say, search_replicates, verify_replicates)
+    pl = Planner(spec, out, workers, executor, say, search_replicates, verify_replicates, assemble)
     doc = pl.run(max_campaigns)
     from vtrials.runner.outputs import json_clean
     (out / "plan.json").write_text(json.dumps(json_clean(doc), indent=1))
