@@ -50,6 +50,7 @@ def _edit(tmp_path, old: str, new: str) -> Path:
     ('"environment.current.direction_deg"', '"environment.nowhere.x"', "climate.environment.nowhere.x",
      "no environment.nowhere"),
     ("[limits]", "[limitz]", "limitz", "unknown table"),
+    ("seed = 5", 'seed = 5\nshape = "cauchy"', "plan.shape", "normal, empirical"),
 ])
 def test_bad_plan_files_are_clear_input_errors(tmp_path, old, new, field, what):
     p = _edit(tmp_path, old, new)
@@ -125,6 +126,14 @@ def test_predicted_fraction_and_quantile_match_sampling():
     e = rng.normal(0.0, 0.05, 200000)
     assert D.predicted_fraction(mse, 0.1) == pytest.approx(np.mean(np.abs(e) <= 0.1), abs=2e-3)
     assert D.predicted_quantile(mse, 0.95) == pytest.approx(np.quantile(np.abs(e), 0.95), rel=1e-2)
+    # the empirical shape: each campaign scaled by its own MSE, pooled; a missing replicate is +inf
+    a, b = np.array([0.1, -0.2, 0.2]), np.array([1.0, -1.0, np.nan])
+    sh = D.error_shape([(a, float(np.mean(a ** 2))), (b, 1.0)])
+    assert sh[-1] == np.inf and sh.size == 6
+    assert sh[:5] == pytest.approx(sorted([0.1 / 0.1732051, 0.2 / 0.1732051, 0.2 / 0.1732051, 1.0, 1.0]), rel=1e-6)
+    assert D.predicted_fraction(4.0, 2.0, sh) == pytest.approx(np.mean(sh <= 1.0))  # tol/√mse = 1
+    pool = D.error_shape([(e, float(np.mean(e ** 2)))])
+    assert D.predicted_quantile(mse, 0.95, pool) == pytest.approx(D.predicted_quantile(mse, 0.95), rel=1e-2)
 
 
 def test_surrogate_recovers_floors_and_slope():
