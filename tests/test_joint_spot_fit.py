@@ -99,3 +99,12 @@ def test_bad_runs_are_clear_errors():
         CUR.joint_spot_current_fit(t, vg, np.full(vg.size, 0.01), hd + np.r_[0.0, 1.2, 0, 0, 0, 0], grp)
     with pytest.raises(ValueError, match="uncertainty"):
         CUR.joint_spot_current_fit(t, vg, np.zeros(vg.size), hd, grp)
+
+
+def test_a_day_of_two_reciprocal_pairs_takes_the_trend_between_them():
+    # two spots of one pair each (four runs): the common offset and the trend fit exactly (no dof left);
+    # in a linearly changing current without heading dependence that is the truth
+    t, hd, grp, vg, truth = _day(n_spots=2, runs=2, amp=0.0, asym=0.0, trend=3e-5)
+    f = CUR.joint_spot_current_fit(t, vg, np.full(vg.size, 0.01), hd, grp)
+    assert f.model == "linear" and f.dof == 0
+    assert np.allclose([e.value for e in f.vs], truth, atol=1e-9)

@@ -188,7 +188,8 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
     part is the current's change with time, resolved from the spots' repeated courses (a three-run spot
     B–R–B: V_G,1 − V_G,3 = c(t₁) − c(t₃)) across the whole day; with model "none" a three-run spot's V_g
     is exactly the mean of means (V₁ + 2V₂ + V₃)/4 for equal σ. ``model`` None: the richest of "tidal"
-    (3 shape terms), "linear" (1), "none" with at least ``min_dof`` residual degrees of freedom.
+    (3 shape terms), "linear" (1), "none" with at least ``min_dof`` residual degrees of freedom (the
+    richest the runs determine at all when none has that many).
     A two-run spot (one run each way) holds no contrast of its own; on a day of such spots the current's
     change is only seen across spots, so ``offsets`` "common" (one offset for the day: the constant
     current, with the heading-dependent speed taken equal at every spot) is tried after the per-spot
@@ -240,15 +241,17 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
     order = [(m, o) for o in offs for m in shapes]
     if model is None:
         order.append(("none", offs[0]))
-    chosen = None
+    chosen = first = None
     for m, o in order:
         X = design(m, o)
         p = X.shape[1]
-        if np.linalg.matrix_rank(X * w[:, None]) < p:
+        if p > n or np.linalg.matrix_rank(X * w[:, None]) < p:
             continue
-        if n - p >= min_dof or (m, o) == order[-1]:
+        first = first or (m, o)
+        if n - p >= min_dof:
             chosen = (m, o)
             break
+    chosen = chosen or first  # too few runs for min_dof: the richest form the runs determine
     if chosen is None:
         raise ValueError("the runs cannot determine a speed per spot")
     X = design(*chosen)

@@ -326,18 +326,14 @@ def reduce_standardization(rec: Record) -> dict:
                                                    delta_r_std=d_r_se, xi_p=xi)
         else:
             p_id, p_id_se = p_ms, p_ms_se
-        # run-to-run power scatter at equal settings (gusts, helm) as seen after the correction
         w = CUR.mean_of_means_weights(n)
-        P = _mom(p_id, np.hypot(p_id_se, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0))
         P_ms = _mom(p_ms, p_ms_se)
         # the torsionmeters' calibration uncertainty is common to the spot's runs: added after averaging
         cal = float(np.mean([r.get("power_calibration_std", 0.0) for r in rs]))
         P_ms = Estimate(P_ms.value, math.hypot(P_ms.std, cal), P_ms.dof)
         # a curve point is the power AT the reduced speed: the speed's uncertainty moves along the curve
         # by its slope, d ln P / d ln V of the tank prediction (3 for a cubic law where there is none)
-        q_loc = slope(vs.value)
-        p_speed = P.value * q_loc * vs.std / vs.value
-        P = Estimate(P.value, math.sqrt(P.std ** 2 + cal ** 2 + p_speed ** 2), P.dof)
+        p_speed = float(np.dot(w, p_id)) * slope(vs.value) * vs.std / vs.value
         rps = _mom([np.mean([float(s["rps"]["mean"]) for s in r["shafts"].values() if s.get("rps")]) for r in rs],
                    [1e-3] * n)
         torque = float(np.dot(w, [sum(s["torque"]["mean"] for s in r["shafts"].values() if s.get("torque"))
@@ -349,13 +345,15 @@ def reduce_standardization(rec: Record) -> dict:
         current_along = [float(si * (vgi - vs.value)) for si, vgi in zip(s_i, v)]
         spots.append({"group": g, "runs": [r["run"] for r in rs], "n_runs": n,
                       "method": f"joint fit of the day's runs (current change: {joint.model})",
-                      "stw": _est(vs), "power_measured": _est(P_ms), "power": _est(P),
+                      "stw": _est(vs), "power_measured": _est(P_ms), "power": None,
                       "power_speed_std": p_speed, "power_calibration_std": cal,
+                      "_corrected": (np.asarray(p_id, float), np.asarray(p_id_se, float), np.sign(s_i), vs.dof),
                       "rps": rps.value, "torque": torque, "thrust": thrust,
                       "current_along_base": current_along, "wind": wind_used, "waves": waves_used,
                       "eta_D": None if eta is None else float(eta), "xi_P": xi,
                       "r_acc": [float(x) for x in np.atleast_1d(r_acc)],
                       "steady": all(r["steady"] for r in rs)})
+    _spot_powers(spots)
     # the faired speed–power curve: monotone cubic through the spots in log–log (trial practice fairs
     # the curve through the spots; a global law — the ITTC power law below — cannot follow a resistance
     # hump to 1 %)
@@ -390,6 +388,51 @@ def reduce_standardization(rec: Record) -> dict:
                                  "a": _est(iterative.a), "b": _est(iterative.b), "q": _est(iterative.q),
                                  "dof": iterative.dof, "runs": [r["run"] for r in runs]}
     return out
+
+
+def _spot_powers(spots: list[dict]) -> None:
+    """Each spot's corrected power (mean of means of its runs' direct-power-method powers) and its
+    budget, named term by term (GUM, JCGM 100:2008; ITTC 7.5-02-01-01):
+
+    * run-to-run scatter of the corrected power (gusts, helm, sea): the relative scatter of runs on the
+      SAME course at the same spot, pooled over the day's spots (dof = number of such repeats less one
+      per course and spot). Runs on opposite courses differ for a real reason — into the wind the ship is
+      slower and needs less power at the same settings (~q ΔV/V, several per cent at low speed) — which
+      the mean of means balances and which is not scatter. A day without same-course repeats (two-run
+      spots) falls back to the spot's own scatter std/√2 over both courses (conservative);
+    * each run's standard error of its mean power and the uncertainty of its resistance corrections
+      (wind coefficient, relative wind, acceleration: :func:`vtrials.reduce.speedpower.direct_power_method`);
+    * the torsionmeters' zero and scale calibration, common to the spot's runs;
+    * the spot speed's uncertainty carried along the curve (``power_speed_std``).
+
+    The interval is Student-t on the Welch–Satterthwaite dof of the scatter and speed terms."""
+    ss, dof = 0.0, 0
+    for sp in spots:
+        p_id, _, sgn, _ = sp["_corrected"]
+        for c in (-1.0, 1.0):
+            x = p_id[sgn == c]
+            if x.size >= 2:
+                rel = x / x.mean() - 1.0
+                ss += float(np.sum(rel ** 2))
+                dof += x.size - 1
+    sigma_rel = math.sqrt(ss / dof) if dof > 0 else None
+    for sp in spots:
+        p_id, p_id_se, sgn, v_dof = sp.pop("_corrected")
+        n = p_id.size
+        w = CUR.mean_of_means_weights(n) if n > 1 else np.ones(1)
+        if sigma_rel is not None:
+            scatter, nu = sigma_rel * p_id, dof
+        else:
+            scatter, nu = np.full(n, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0), max(n - 1, 1)
+        value = float(np.dot(w, p_id))
+        u_scatter2 = float(np.sum((w * scatter) ** 2))
+        u_runs2 = float(np.sum((w * p_id_se) ** 2))
+        u_speed = sp["power_speed_std"]
+        u2 = u_scatter2 + u_runs2 + sp["power_calibration_std"] ** 2 + u_speed ** 2
+        den = u_scatter2 ** 2 / nu + (u_speed ** 4 / v_dof if v_dof else 0.0)
+        nu_eff = u2 ** 2 / den if den > 0 else None
+        sp["power"] = Estimate(value, math.sqrt(u2), nu_eff).to_dict()
+        sp["power_scatter_rel_std"] = None if sigma_rel is None else sigma_rel
 
 
 def curve_power(curve: dict, v) -> np.ndarray:
