@@ -1,6 +1,7 @@
 """The standardization day's joint fit (vtrials.reduce.current.joint_spot_current_fit): exact on a
 synthetic day whose answer is known, the mean of means where it should be, and 95 % intervals that
-cover 95 % of noisy synthetic days (Monte Carlo)."""
+cover 95 % of noisy synthetic days (Monte Carlo); the spot power budget's pooled scatter
+(vtrials.reduce.trials._spot_powers) likewise."""
 
 from __future__ import annotations
 
@@ -108,3 +109,36 @@ def test_a_day_of_two_reciprocal_pairs_takes_the_trend_between_them():
     f = CUR.joint_spot_current_fit(t, vg, np.full(vg.size, 0.01), hd, grp)
     assert f.model == "linear" and f.dof == 0
     assert np.allclose([e.value for e in f.vs], truth, atol=1e-9)
+
+
+def _spots(p_true, asym, noise, rng, runs=3):
+    """Spots of B–R–B runs: corrected powers P(1 ∓ asym) on the two courses, scattered by ``noise``."""
+    spots = []
+    for P in p_true:
+        sgn = np.array([1.0 if j % 2 == 0 else -1.0 for j in range(runs)])
+        p = P * (1.0 - sgn * asym) * (1.0 + rng.normal(0.0, noise, runs))
+        spots.append({"_corrected": (p, np.full(runs, 1e-6 * P), sgn, None), "power_speed_std": 0.0,
+                      "power_calibration_std": 0.0})
+    return spots
+
+
+def test_spot_power_scatter_is_pooled_over_same_course_runs():
+    """Into the wind the ship needs less power at the same settings than with it (±4 % here): the mean
+    of means balances that, and the budget's scatter must not count it. Runs scatter 1 % about it; the
+    pooled same-course scatter finds 1 % and the intervals cover the balanced truth ~95 % (Monte Carlo)."""
+    from vtrials.reduce.trials import _spot_powers
+    rng = np.random.default_rng(4)
+    p_true = np.linspace(2e5, 3e6, 8)
+    sig, cov, hw, err = [], [], [], []
+    for _ in range(300):
+        spots = _spots(p_true, 0.04, 0.01, rng)
+        _spot_powers(spots)
+        sig.append(spots[0]["power_scatter_rel_std"])
+        for sp, P in zip(spots, p_true):
+            c = sp["power"]
+            cov.append(c["lo95"] <= P <= c["hi95"])
+            hw.append(0.5 * (c["hi95"] - c["lo95"]) / P)
+            err.append(abs(c["value"] / P - 1.0))
+    assert np.mean(sig) == pytest.approx(0.01, rel=0.08)  # not the ±4 % between the courses
+    assert 0.93 <= np.mean(cov) <= 0.975, np.mean(cov)
+    assert 0.9 <= np.mean(hw) / np.quantile(err, 0.95) <= 1.4
