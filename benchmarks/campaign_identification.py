@@ -150,7 +150,7 @@ def _scenario(ship: str, seed: int, scale: int, where: Path) -> Path:
 
 
 def _replicate(args) -> dict:
-    ship, i, seed, scale, held, tmp = args
+    ship, i, seed, scale, held, tmp, refine = args
     import vtrials
     from vtrials.score.identification import score
     from vtrials.sysid.identify import identify_records
@@ -163,7 +163,8 @@ def _replicate(args) -> dict:
         if not held:   # held back from the replicate's own run
             held = [p for p in recs if p.stem in SHIPS[ship]["held_back"]]
         train = [p for p in recs if p not in held]
-        doc = identify_records(train, None, True, held, compare=(), with_contributions=False)
+        doc = identify_records(train, None, True, held, compare=(), with_contributions=False,
+                               refine=refine, diagnostics=True)
         sc = score(doc)
     finally:
         shutil.rmtree(work, ignore_errors=True)
@@ -172,7 +173,18 @@ def _replicate(args) -> dict:
     for k in SHIPS[ship]["linear"]:
         c, s = doc["coefficients"][k], sc["coefficients"][k]
         row["coefficients"][k] = {"value": c["value"], "lo95": c["lo95"], "hi95": c["hi95"], "truth": s["truth"],
-                                  "rel_error": s["rel_error"], "covered": s["covered"]}
+                                  "rel_error": s["rel_error"], "covered": s["covered"],
+                                  "std_random": c["std_random"], "std_systematic": c["std_systematic"],
+                                  "std_random_by_lags": doc["diagnostics"]["sigma_random"][k]}
+        if "output_error" in doc:
+            c, s = doc["output_error"]["coefficients"][k], sc["output_error"]["coefficients"][k]
+            row.setdefault("output_error", {})[k] = {
+                "value": c["value"], "lo95": c["lo95"], "hi95": c["hi95"], "truth": s["truth"],
+                "rel_error": s["rel_error"], "covered": s["covered"], "std_random": c["std_random"],
+                "std_systematic": c["std_systematic"]}
+    if "output_error" in doc:
+        row["output_error_fit"] = {k: doc["output_error"][k] for k in ("rms_weighted", "improved", "nfev", "lags")}
+    row["andrews_lags"] = {eq: d["andrews_lags"] for eq, d in doc["diagnostics"].items() if eq in "XYNK"}
     return row
 
 
@@ -203,6 +215,32 @@ def _smoother(args) -> dict:
     return out
 
 
+def _bandwidth_study(rs, LINEAR) -> dict:
+    """Coverage and sharpness of the linear derivatives' 95 % intervals had the regression's random σ
+    come from a fixed Newey–West bandwidth (samples), or from the largest σ over the bandwidths up to
+    400 ("plateau"), each with the record-wide errors' σ added as in the pipeline."""
+    from vtrials.score.coverage import verdict
+    Z = 1.959963984540054
+    lags = list(rs[0]["coefficients"][LINEAR[0]]["std_random_by_lags"])
+    out = {}
+    for rule in lags + ["plateau", "reported"]:
+        per = {}
+        for k in LINEAR:
+            c = [r["coefficients"][k] for r in rs]
+            if rule == "plateau":
+                sr = np.array([max(x["std_random_by_lags"].values()) for x in c])
+            elif rule == "reported":
+                sr = np.array([x["std_random"] for x in c])
+            else:
+                sr = np.array([x["std_random_by_lags"][rule] for x in c])
+            sd = np.hypot(sr, [x["std_systematic"] for x in c])
+            err = np.array([x["value"] - x["truth"] for x in c])
+            v = verdict(list(np.abs(err) <= Z * sd), Z * sd, err)
+            per[k] = {key: v[key] for key in ("coverage", "wilson_lo", "wilson_hi", "sharpness", "verdict")}
+        out[rule] = per
+    return out
+
+
 def summarise(rows: list[dict]) -> dict:
     from vtrials.score.coverage import verdict
     LINEAR = tuple(rows[0]["coefficients"])
@@ -226,6 +264,25 @@ def summarise(rows: list[dict]) -> dict:
                     val = abs(e.get("rel_error", e.get("error_deg")))
                     worst[key] = max(worst.get(key, 0.0), val)
         out[f"noise_x{scale}"] = {"replicates": len(rs), "linear": per, "worst_prediction_error": worst}
+        oe_rows = [r for r in rs if "output_error" in r]
+        if oe_rows:
+            oe = {}
+            for k in LINEAR:
+                c = [r["output_error"][k] for r in oe_rows]
+                err = np.array([x["value"] - x["truth"] for x in c])
+                v = verdict([x["covered"] for x in c], np.array([(x["hi95"] - x["lo95"]) / 2 for x in c]), err)
+                rel = np.array([x["rel_error"] for x in c])
+                # the equation-error estimate on the same replicates, for comparison
+                rel_ee = np.array([r["coefficients"][k]["rel_error"] for r in oe_rows])
+                v.update(mean_rel_error=float(rel.mean()), rms_rel_error=float(np.sqrt(np.mean(rel**2))),
+                         max_abs_rel_error=float(np.abs(rel).max()),
+                         rms_rel_error_equation_error_same_replicates=float(np.sqrt(np.mean(rel_ee**2))))
+                oe[k] = v
+            out[f"noise_x{scale}"]["output_error"] = {
+                "replicates": len(oe_rows), "linear": oe,
+                "improved_fit": int(sum(r["output_error_fit"]["improved"] for r in oe_rows))}
+        if all("std_random_by_lags" in r["coefficients"][LINEAR[0]] for r in rs):
+            out[f"noise_x{scale}"]["bandwidth_study"] = _bandwidth_study(rs, LINEAR)
     if "noise_x1" in out and "noise_x2" in out:
         out["rms_growth_x2"] = {k: out["noise_x2"]["linear"][k]["rms_rel_error"]
                                 / out["noise_x1"]["linear"][k]["rms_rel_error"] for k in LINEAR}
@@ -239,6 +296,10 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=2016)
     ap.add_argument("--noise-scale", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--refine", choices=("none", "oe"), default="none",
+                    help="also the output-error (LM) refinement, scored beside the equation-error estimate")
+    ap.add_argument("--oe-replicates", type=int, default=10**9,
+                    help="output error on the first N replicates of the nominal suite only (it costs ~20 s each)")
     ap.add_argument("--smoother", action="store_true",
                     help="check the smoother's states and covariance against truth instead (no identification)")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "campaign_identification.json"))
@@ -255,7 +316,9 @@ def main(argv=None) -> int:
             d = Path(tmp) / scn.stem
             vtrials.run(str(scn), str(d), plot=False)
             held += [p for pat in cfg["held_back"] for p in sorted((d / "records").glob(f"{pat}.nc"))]
-        jobs = [(a.ship, i, s, scale, [str(h) for h in held], tmp) for scale in a.noise_scale for i, s in enumerate(seeds)]
+        jobs = [(a.ship, i, s, scale, [str(h) for h in held], tmp,
+                 "oe" if a.refine == "oe" and scale == 1 and i < a.oe_replicates else None)
+                for scale in a.noise_scale for i, s in enumerate(seeds)]
         rows = []
         with ProcessPoolExecutor(a.workers) as ex:
             for k, row in enumerate(ex.map(_replicate, jobs)):
