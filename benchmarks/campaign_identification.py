@@ -175,7 +175,8 @@ def _replicate(args) -> dict:
         row["coefficients"][k] = {"value": c["value"], "lo95": c["lo95"], "hi95": c["hi95"], "truth": s["truth"],
                                   "rel_error": s["rel_error"], "covered": s["covered"],
                                   "std_random": c["std_random"], "std_systematic": c["std_systematic"],
-                                  "std_random_by_lags": doc["diagnostics"]["sigma_random"][k]}
+                                  "std_random_by_lags": doc["diagnostics"]["sigma_random"][k],
+                                  "std_random_andrews": doc["diagnostics"]["sigma_random_andrews"][k]}
         if "output_error" in doc:
             c, s = doc["output_error"]["coefficients"][k], sc["output_error"]["coefficients"][k]
             row.setdefault("output_error", {})[k] = {
@@ -184,7 +185,9 @@ def _replicate(args) -> dict:
                 "std_systematic": c["std_systematic"]}
     if "output_error" in doc:
         row["output_error_fit"] = {k: doc["output_error"][k] for k in ("rms_weighted", "improved", "nfev", "lags")}
-    row["andrews_lags"] = {eq: d["andrews_lags"] for eq, d in doc["diagnostics"].items() if eq in "XYNK"}
+    row["bandwidth"] = {eq: {key: d[key] for key in ("andrews_lags", "plateau_lags", "fixed_b", "lag1")}
+                        | {"segment_mean": float(np.mean(d["segment_samples"]))}
+                        for eq, d in doc["diagnostics"].items() if eq in "XYNK"}
     return row
 
 
@@ -218,19 +221,28 @@ def _smoother(args) -> dict:
 def _bandwidth_study(rs, LINEAR) -> dict:
     """Coverage and sharpness of the linear derivatives' 95 % intervals had the regression's random σ
     come from a fixed Newey–West bandwidth (samples), or from the largest σ over the bandwidths up to
-    400 ("plateau"), each with the record-wide errors' σ added as in the pipeline."""
+    400, or with the fixed-b widening at a fixed bandwidth; "andrews (before)": Andrews' AR(1) bandwidth
+    alone (the pipeline before the bandwidth study); "reported": the pipeline's own intervals. Each with
+    the record-wide errors' σ added as in the pipeline."""
     from vtrials.score.coverage import verdict
     Z = 1.959963984540054
+    from vtrials.sysid.output_error import fixed_b_factor
     lags = list(rs[0]["coefficients"][LINEAR[0]]["std_random_by_lags"])
     out = {}
-    for rule in lags + ["plateau", "reported"]:
+    for rule in ["andrews (before)", "reported"] + lags + [f"{L}+fixed_b" for L in lags] + ["max over 0-400"]:
         per = {}
         for k in LINEAR:
             c = [r["coefficients"][k] for r in rs]
-            if rule == "plateau":
+            if rule == "max over 0-400":
                 sr = np.array([max(x["std_random_by_lags"].values()) for x in c])
             elif rule == "reported":
                 sr = np.array([x["std_random"] for x in c])
+            elif rule == "andrews (before)":
+                sr = np.array([x["std_random_andrews"] for x in c])
+            elif rule.endswith("+fixed_b"):
+                L = rule.split("+")[0]
+                sr = np.array([x["std_random_by_lags"][L] * fixed_b_factor(int(L) / r["bandwidth"][k[0]]["segment_mean"])
+                               for x, r in zip(c, rs)])
             else:
                 sr = np.array([x["std_random_by_lags"][rule] for x in c])
             sd = np.hypot(sr, [x["std_systematic"] for x in c])
@@ -323,8 +335,12 @@ def main(argv=None) -> int:
         with ProcessPoolExecutor(a.workers) as ex:
             for k, row in enumerate(ex.map(_replicate, jobs)):
                 rows.append(row)
-                if (k + 1) % 10 == 0:
+                if (k + 1) % 5 == 0:
                     print(f"{k + 1}/{len(jobs)} replicates, {time.perf_counter() - t0:.0f} s", flush=True)
+                    partial = {"ship": a.ship, "campaign_seed": a.seed, "replicates": a.replicates, "partial": True,
+                               "wall_s": time.perf_counter() - t0, "summary": summarise(rows), "rows": rows}
+                    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+                    Path(a.out).write_text(json.dumps(partial, indent=1))
     doc = {"ship": a.ship, "campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
            "summary": summarise(rows), "rows": rows}
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)

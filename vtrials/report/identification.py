@@ -37,7 +37,20 @@ def identification_plot(doc: dict, path) -> None:
         scale = np.abs(val)
         v, lo, hi = val / scale, lo / scale, hi / scale
         ax[0].set_xlabel("identified value over its magnitude (SI terms), 95 % interval")
-    ax[0].errorbar(v, y, xerr=[v - lo, hi - v], fmt="o", ms=4, capsize=3)
+    oe = (doc.get("output_error") or {}).get("coefficients", {})
+    ax[0].errorbar(v, y, xerr=[v - lo, hi - v], fmt="o", ms=4, capsize=3,
+                   label="equation error" if oe else None)
+    if oe:   # the output-error refinement beside it, on the same scale
+        ko = [i for i, k in enumerate(terms) if k in oe]
+        o = [oe[terms[i]] for i in ko]
+        ov, olo, ohi = (np.array([x[key] for x in o]) for key in ("value", "lo95", "hi95"))
+        if sc:
+            ov, olo, ohi = ((a - t[ko]) / scale[ko] for a in (ov, olo, ohi))
+        elif not prime:
+            ov, olo, ohi = (a / np.abs(val[ko]) for a in (ov, olo, ohi))
+        ax[0].errorbar(ov, y[ko] + 0.3, xerr=[ov - olo, ohi - ov], fmt="s", ms=4, capsize=3, color="C3",
+                       label="output error (LM)")
+        ax[0].legend(fontsize=8)
     # linear near zero (prime units up to 0.01; relative errors up to 30 %), logarithmic beyond
     ax[0].set_xscale("symlog", linthresh=0.01 if prime else 0.3)
     ax[0].set_yticks(y, terms)

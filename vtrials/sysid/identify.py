@@ -90,9 +90,9 @@ def systematic_covariance(ship, segs, errors, fits) -> tuple[dict, dict]:
 #: makes the adaptive integrator crawl; 0.5 s is well inside the steering gear's 1–2 s to put the rudder
 #: over) and the LM's evaluation budget.
 OE_CHANNELS = ("u", "v", "r", "psi")
-OE_STEP_S = 0.5
+OE_STEP_S = 1.0
 OE_INPUT_WINDOW_S = 0.5
-OE_MAX_NFEV = 12
+OE_MAX_NFEV = 10
 
 
 def _smooth_input(t, x, window_s):
@@ -148,7 +148,8 @@ def output_error(ship, sols, segs, errors, start: dict, free=None, channels=OE_C
     relaxation step, :func:`~vtrials.sysid.output_error.channel_sigmas`; never below the smoother's median
     σ); LM at those weights. Covariance: the sandwich (JᵀJ)⁻¹ M (JᵀJ)⁻¹ with M the Newey–West sum of the
     scores (Andrews' bandwidth): output-error residuals are correlated over many samples, and the white
-    s² (JᵀJ)⁻¹ would overstate the information by n/n_eff (reported as ``n_over_n_eff``); plus the
+    s² (JᵀJ)⁻¹ would overstate the information by n/n_eff (reported as ``n_over_n_eff``), widened by the
+    fixed-b factor for a bandwidth that is a sizeable part of each record (reported as ``fixed_b``); plus the
     record-wide errors (gyro zero, rudder zero and clock) as linearised sensitivities (GUM)."""
     if not ship.prime:
         raise InputError(_WHERE, "refine", "output error is implemented for the 3-DOF MMG model; allowed: "
@@ -183,10 +184,11 @@ def output_error(ship, sols, segs, errors, start: dict, free=None, channels=OE_C
     return {"coefficients": coeffs, "free": list(free), "channels": list(channels), "channel_sigma": sig0,
             "step_s": OE_STEP_S, "rms_weighted": {"start": float(np.sqrt(cost0)), "refined": res.rms},
             "improved": bool(res.rms < np.sqrt(cost0)), "nfev": res.nfev, "lags": res.lags,
+            "fixed_b": res.fixed_b,
             "n_over_n_eff": {k: float(var_r[j] / white[j]) for j, k in enumerate(free) if white[j] > 0},
             "systematic_share": share,
-            "interval": "95 %: ±1.96 σ; σ² = Newey–West sandwich of the output-error Jacobian (Andrews' bandwidth) "
-                        "+ the record-wide errors' variance (gyro zero, rudder zero and clock; linearised GUM "
+            "interval": "95 %: ±1.96 σ; σ² = Newey–West sandwich of the output-error Jacobian (Andrews' bandwidth, "
+                        "fixed-b widening: Kiefer & Vogelsang 2005) + the record-wide errors' variance (gyro zero, rudder zero and clock; linearised GUM "
                         "sensitivities)"}
 
 
@@ -210,6 +212,45 @@ def contributions(ship, segs, names, structure: str = "mmg") -> dict:
 #: Newey–West bandwidths (samples) at which the linear derivatives' random σ is reported for the
 #: campaign's bandwidth study (``diagnostics``)
 LAG_LADDER = (0, 10, 25, 50, 100, 200, 400)
+
+
+def random_sigma(ship, segs, eq: str, ft: RG.Fit) -> tuple[np.ndarray, int, float]:
+    """The regression's random σ of each term: the Newey–West σ at the bandwidth where it levels off,
+    widened for that bandwidth by the fixed-b factor; returns (σ, bandwidth, factor).
+
+    Why not Andrews' AR(1) rule alone (the fit's own ``lags="auto"``): the hull-force residuals are a
+    mixture of white noise (the accelerometers', 20 Hz) and slow errors of the reconstruction (the
+    tracking's correlated errors, which the smoother takes as white; seconds to a minute). The AR(1)
+    plug-in reads the lag-1 correlation, which the white part holds near zero in the sway equation
+    (ρ₁ ≈ 0.04 on the shipped KVLCC2 agenda: 5 lags, 0.25 s), and misses the slow part: the Newey–West
+    σ of Y'_v grows by 30 % from 5 to 100 lags and levels off there. So: the bandwidths from Andrews'
+    up, doubling, to a quarter of the shortest maneuver; the largest σ of each term among them (the
+    plateau; a HAC variance falls again at long bandwidths only through the Bartlett window's bias);
+    and since a bandwidth that is a fraction b of the record leaves the HAC variance biased low and
+    uncertain, the fixed-b widening (:func:`vtrials.sysid.output_error.fixed_b_factor`, Kiefer &
+    Vogelsang 2005) at the bandwidth where the σ of the linear derivatives peaks."""
+    A, y, bnd = RG.design(ship, segs, eq, ft.terms, weighted=True)
+    seg_n = np.diff(bnd)
+    cap = max(1, int(seg_n.min()) // 4)
+    e = y - A @ ft.coef
+    L = max(1, RG.andrews_lags(e, bnd))
+    ladder = []
+    while L <= cap:
+        ladder.append(L)
+        L *= 2
+    best, best_L = ft.sigma(), RG.andrews_lags(e, bnd)
+    lin = [i for i, k in enumerate(ft.terms) if k in ship.linear] or list(range(len(ft.terms)))
+    peak = float(np.sum((best / np.maximum(ft.sigma(), 1e-300))[lin]))
+    out = best.copy()
+    sigmas = RG.hac_sigmas(A, y, ft.coef, bnd, ladder) if ladder else {}
+    for L in ladder:
+        sg = sigmas[L]
+        out = np.maximum(out, sg)
+        score = float(np.sum((sg / np.maximum(ft.sigma(), 1e-300))[lin]))
+        if score > peak:
+            peak, best_L = score, L
+    factor = OE.fixed_b_factor(best_L / float(np.mean(seg_n)))
+    return out * factor, int(best_L), float(factor)
 
 
 def identify_records(paths, structure: str | None = None, select: bool = True, held_back=(),
@@ -248,9 +289,10 @@ def identify_records(paths, structure: str | None = None, select: bool = True, h
     errors = [record_errors(m) for m in mrs]
     sys_cov, sys_share = systematic_covariance(ship, segs, errors, fits)
     coeffs = {}
+    rand = {eq: random_sigma(ship, segs, eq, ft) for eq, ft in fits.items()}
     for eq, ft in fits.items():
         var_sys = np.diag(sys_cov[eq])
-        for k, c, s, vs in zip(ft.terms, ft.coef, ft.sigma(), var_sys):
+        for k, c, s, vs in zip(ft.terms, ft.coef, rand[eq][0], var_sys):
             sd = float(np.sqrt(s * s + vs))
             coeffs[k] = {"value": float(c), "std": sd, "lo95": float(c - Z95 * sd), "hi95": float(c + Z95 * sd),
                          "std_random": float(s), "std_systematic": float(np.sqrt(vs))}
@@ -260,10 +302,15 @@ def identify_records(paths, structure: str | None = None, select: bool = True, h
         for eq, ft in fits.items():
             A, y, bnd = RG.design(ship, segs, eq, ft.terms, weighted=True)
             e = y - A @ ft.coef
-            diag[eq] = {"andrews_lags": RG.andrews_lags(e, bnd), "lag1": RG._lag1(e, bnd)}
+            diag[eq] = {"andrews_lags": RG.andrews_lags(e, bnd), "lag1": RG._lag1(e, bnd),
+                        "plateau_lags": rand[eq][1], "fixed_b": rand[eq][2],
+                        "segment_samples": [int(b) for b in np.diff(bnd)]}
+            for k, v in zip(ft.terms, ft.sigma()):
+                if k in ship.linear:
+                    diag.setdefault("sigma_random_andrews", {})[k] = float(v)
+            ladder = RG.hac_sigmas(A, y, ft.coef, bnd, LAG_LADDER)
             for L in LAG_LADDER:
-                sg = RG.ols(A, y, ft.terms, bnd, L).sigma()
-                for k, v in zip(ft.terms, sg):
+                for k, v in zip(ft.terms, ladder[L]):
                     if k in ship.linear:
                         diag.setdefault("sigma_random", {}).setdefault(k, {})[str(L)] = float(v)
     structures = tuple(dict.fromkeys((structure, *compare)))
@@ -311,6 +358,7 @@ def identify_records(paths, structure: str | None = None, select: bool = True, h
             "intervals_checked": list(ship.linear),
             "intervals_note": "coverage measured for the linear derivatives only (benchmarks/campaign_identification.py); "
                               "the cubic terms trade off against one another and their intervals are not calibrated",
-            "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression (Bartlett "
-                        "bandwidth by Andrews' 1991 AR(1) rule) + the record-wide errors' variance (gyro zero, rudder "
-                        "synchro calibration and clock; GUM sensitivities)"}
+            "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression at the "
+                        "bandwidth where it levels off (from Andrews' 1991 AR(1) rule up, doubling, to a quarter of the "
+                        "shortest maneuver), widened by the fixed-b factor (Kiefer & Vogelsang 2005), + the record-wide "
+                        "errors' variance (gyro zero, rudder synchro calibration and clock; GUM sensitivities)"}

@@ -126,6 +126,35 @@ def _hac(A, e, bounds, lags: int):
     return S
 
 
+def hac_sigmas(A, y, coef, bounds, lags_list) -> dict:
+    """σ of the OLS coefficients under the Newey–West covariance (as :func:`ols`) at each bandwidth of
+    ``lags_list`` at once: the scores' lagged cross-products within each segment from one FFT
+    (Wiener–Khinchin; the same sums :func:`_hac` forms lag by lag, to rounding)."""
+    A = np.asarray(A, float)
+    n, p = A.shape
+    e = np.asarray(y, float) - A @ coef
+    g = A * e[:, None]
+    top = int(max(lags_list))
+    C = np.zeros((top + 1, p, p))
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        m = b - a
+        if m < 1:
+            continue
+        nfft = 1 << int(np.ceil(np.log2(2 * m)))
+        F = np.fft.rfft(g[a:b], nfft, axis=0)
+        c = np.fft.irfft(F[:, :, None] * np.conj(F[:, None, :]), nfft, axis=0)   # Σ_t g_i[t+l] g_j[t]
+        k = min(top, m - 1)
+        C[:k + 1] += c[:k + 1]
+    AtA_inv = np.linalg.pinv(A.T @ A)
+    out = {}
+    for L in lags_list:
+        S = C[0].copy()
+        for lag in range(1, int(L) + 1):
+            S += (1.0 - lag / (L + 1.0)) * (C[lag] + C[lag].T)
+        out[L] = np.sqrt(np.diag(AtA_inv @ S @ AtA_inv) * n / (n - p))
+    return out
+
+
 def _lag1(e, bounds) -> float:
     """Lag-1 autocorrelation of residuals pooled within segments (never across a boundary)."""
     num = sum(float(np.dot(e[a + 1:b], e[a:b - 1])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a > 1)
