@@ -139,7 +139,7 @@ def _oe_perturbed(man: OE.Maneuver, source: str, d: float) -> OE.Maneuver:
 
 
 def output_error(ship, sols, segs, errors, start: dict, free=None, channels=OE_CHANNELS,
-                 max_nfev: int = OE_MAX_NFEV) -> dict:
+                 max_nfev: int = OE_MAX_NFEV, names=None) -> dict:
     """Output-error refinement (:func:`vtrials.sysid.output_error.refine`, Levenberg–Marquardt) of the
     ``free`` hull coefficients (default: all of ``start``) from the equation-error estimate ``start``,
     fitting the model's simulated u, v, r, ψ to the smoothed ones over every identification maneuver.
@@ -173,6 +173,14 @@ def output_error(ship, sols, segs, errors, start: dict, free=None, channels=OE_C
                 if k in ship.linear:
                     share.setdefault(k, {}).setdefault(source, 0.0)
                     share[k][source] += float(dk * dk)
+    traces = []   # the fit: measured, start (equation error) and refined model, for the report
+    for i, man in enumerate(mans):
+        tt = man.outputs[channels[0]][0]
+        a, b = OE.simulate(ship, start, man, tt), OE.simulate(ship, res.coeffs, man, tt)
+        traces.append({"name": names[i] if names else str(i), "t": tt.tolist(),
+                       **{f"{ch}_{kind}": x.tolist() for ch in channels
+                          for kind, x in (("measured", man.outputs[ch][1]), ("start", a[OE.CHANNELS.index(ch)]),
+                                          ("refined", b[OE.CHANNELS.index(ch)]))}})
     var_r, var_s = np.diag(res.cov), np.diag(sys_cov)
     coeffs = {}
     for j, k in enumerate(free):
@@ -186,7 +194,7 @@ def output_error(ship, sols, segs, errors, start: dict, free=None, channels=OE_C
             "improved": bool(res.rms < np.sqrt(cost0)), "nfev": res.nfev, "lags": res.lags,
             "fixed_b": res.fixed_b,
             "n_over_n_eff": {k: float(var_r[j] / white[j]) for j, k in enumerate(free) if white[j] > 0},
-            "systematic_share": share,
+            "systematic_share": share, "traces": traces,
             "interval": "95 %: ±1.96 σ; σ² = Newey–West sandwich of the output-error Jacobian (Andrews' bandwidth, "
                         "fixed-b widening: Kiefer & Vogelsang 2005) + the record-wide errors' variance (gyro zero, rudder zero and clock; linearised GUM "
                         "sensitivities)"}
@@ -296,7 +304,8 @@ def identify_records(paths, structure: str | None = None, select: bool = True, h
             sd = float(np.sqrt(s * s + vs))
             coeffs[k] = {"value": float(c), "std": sd, "lo95": float(c - Z95 * sd), "hi95": float(c + Z95 * sd),
                          "std_random": float(s), "std_systematic": float(np.sqrt(vs))}
-    oe_doc = output_error(ship, sols, segs, errors, RG.coefficients(fits)) if refine == "oe" else None
+    oe_doc = (output_error(ship, sols, segs, errors, RG.coefficients(fits), names=[m.name for m in mrs])
+              if refine == "oe" else None)
     diag = {}
     if diagnostics:
         for eq, ft in fits.items():
