@@ -193,7 +193,7 @@ def _replicate(args) -> dict:
                 "std_systematic": c["std_systematic"]}
     if "output_error" in doc:
         row["output_error_fit"] = {k: doc["output_error"][k] for k in ("rms_weighted", "improved", "nfev", "lags")}
-    row["bandwidth"] = {eq: {key: d[key] for key in ("andrews_lags", "plateau_lags", "fixed_b", "lag1")}
+    row["bandwidth"] = {eq: {key: d[key] for key in ("andrews_lags", "plateau_lags", "lag1") if key in d}
                         | {"segment_mean": float(np.mean(d["segment_samples"]))}
                         for eq, d in doc["diagnostics"].items() if eq in "XYNK"}
     return row
@@ -229,20 +229,21 @@ def _smoother(args) -> dict:
 def _bandwidth_study(rs, LINEAR) -> dict:
     """Coverage and sharpness of the linear derivatives' 95 % intervals had the regression's random σ
     come from a fixed Newey–West bandwidth (samples), or from the largest σ over the bandwidths up to
-    400, or with the fixed-b widening at a fixed bandwidth; "andrews (before)": Andrews' AR(1) bandwidth
-    alone (the pipeline before the bandwidth study); "reported": the pipeline's own intervals. Each with
-    the record-wide errors' σ added as in the pipeline."""
+    400 and Andrews' (the pipeline's rule since the study, :func:`vtrials.sysid.identify.random_sigma`),
+    or with the fixed-b widening at a fixed bandwidth; "andrews (before)": Andrews' AR(1) bandwidth alone
+    (the pipeline before the study); "reported": the intervals the rows hold (the code that ran them).
+    Each with the record-wide errors' σ added as in the pipeline."""
     from vtrials.score.coverage import verdict
     Z = 1.959963984540054
     from vtrials.sysid.output_error import fixed_b_factor
     lags = list(rs[0]["coefficients"][LINEAR[0]]["std_random_by_lags"])
     out = {}
-    for rule in ["andrews (before)", "reported"] + lags + [f"{L}+fixed_b" for L in lags] + ["max over 0-400"]:
+    for rule in ["andrews (before)", "reported"] + lags + [f"{L}+fixed_b" for L in lags] + ["max over 0-400 and Andrews'"]:
         per = {}
         for k in LINEAR:
             c = [r["coefficients"][k] for r in rs]
-            if rule == "max over 0-400":
-                sr = np.array([max(x["std_random_by_lags"].values()) for x in c])
+            if rule.startswith("max over"):   # the pipeline's rule (vtrials.sysid.identify.random_sigma)
+                sr = np.array([max(max(x["std_random_by_lags"].values()), x["std_random_andrews"]) for x in c])
             elif rule == "reported":
                 sr = np.array([x["std_random"] for x in c])
             elif rule == "andrews (before)":

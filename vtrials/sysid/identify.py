@@ -222,43 +222,27 @@ def contributions(ship, segs, names, structure: str = "mmg") -> dict:
 LAG_LADDER = (0, 10, 25, 50, 100, 200, 400)
 
 
-def random_sigma(ship, segs, eq: str, ft: RG.Fit) -> tuple[np.ndarray, int, float]:
-    """The regression's random σ of each term: the Newey–West σ at the bandwidth where it levels off,
-    widened for that bandwidth by the fixed-b factor; returns (σ, bandwidth, factor).
+def random_sigma(ship, segs, eq: str, ft: RG.Fit) -> tuple[np.ndarray, int]:
+    """The regression's random σ of each term: the largest Newey–West σ over the bandwidths of
+    :data:`LAG_LADDER` up to a quarter of the shortest maneuver and Andrews' own; returns (σ, the
+    bandwidth at which the linear derivatives' σ peak).
 
     Why not Andrews' AR(1) rule alone (the fit's own ``lags="auto"``): the hull-force residuals are a
     mixture of white noise (the accelerometers', 20 Hz) and slow errors of the reconstruction (the
     tracking's correlated errors, which the smoother takes as white; seconds to a minute). The AR(1)
     plug-in reads the lag-1 correlation, which the white part holds near zero in the sway equation
-    (ρ₁ ≈ 0.04 on the shipped KVLCC2 agenda: 5 lags, 0.25 s), and misses the slow part: the Newey–West
-    σ of Y'_v grows by 30 % from 5 to 100 lags and levels off there. So: the bandwidths from Andrews'
-    up, doubling, to a quarter of the shortest maneuver; the largest σ of each term among them (the
-    plateau; a HAC variance falls again at long bandwidths only through the Bartlett window's bias);
-    and since a bandwidth that is a fraction b of the record leaves the HAC variance biased low and
-    uncertain, the fixed-b widening (:func:`vtrials.sysid.output_error.fixed_b_factor`, Kiefer &
-    Vogelsang 2005) at the bandwidth where the σ of the linear derivatives peaks."""
+    (ρ₁ ≈ 0.03 on the KVLCC2 agenda: 4–5 lags, 0.25 s), and misses the slow part: the Newey–West σ of
+    Y'_v grows by 30–40 % from there to 100–200 lags and levels off (it falls again at long bandwidths
+    only through the Bartlett window's bias). The largest σ over the bandwidths is the plateau.
+    (The fixed-b widening of :func:`vtrials.sysid.output_error.fixed_b_factor` on top of it made the
+    yaw derivatives' intervals too wide in the campaign's first replicates, sharpness ≈ 1.6: taking the
+    largest σ over the bandwidths already errs on the wide side; the output-error refinement, with one
+    bandwidth, keeps it.)"""
     A, y, bnd = RG.design(ship, segs, eq, ft.terms, weighted=True)
-    seg_n = np.diff(bnd)
-    cap = max(1, int(seg_n.min()) // 4)
-    e = y - A @ ft.coef
-    L = max(1, RG.andrews_lags(e, bnd))
-    ladder = []
-    while L <= cap:
-        ladder.append(L)
-        L *= 2
-    best, best_L = ft.sigma(), RG.andrews_lags(e, bnd)
+    out, sigmas = RG.plateau_sigma(A, y, ft.coef, bnd, LAG_LADDER)
     lin = [i for i, k in enumerate(ft.terms) if k in ship.linear] or list(range(len(ft.terms)))
-    peak = float(np.sum((best / np.maximum(ft.sigma(), 1e-300))[lin]))
-    out = best.copy()
-    sigmas = RG.hac_sigmas(A, y, ft.coef, bnd, ladder) if ladder else {}
-    for L in ladder:
-        sg = sigmas[L]
-        out = np.maximum(out, sg)
-        score = float(np.sum((sg / np.maximum(ft.sigma(), 1e-300))[lin]))
-        if score > peak:
-            peak, best_L = score, L
-    factor = OE.fixed_b_factor(best_L / float(np.mean(seg_n)))
-    return out * factor, int(best_L), float(factor)
+    peak = max(sigmas, key=lambda L: float(np.sum(sigmas[L][lin] / np.maximum(ft.sigma()[lin], 1e-300))))
+    return out, int(peak)
 
 
 def identify_records(paths, structure: str | None = None, select: bool = True, held_back=(),
@@ -312,7 +296,7 @@ def identify_records(paths, structure: str | None = None, select: bool = True, h
             A, y, bnd = RG.design(ship, segs, eq, ft.terms, weighted=True)
             e = y - A @ ft.coef
             diag[eq] = {"andrews_lags": RG.andrews_lags(e, bnd), "lag1": RG._lag1(e, bnd),
-                        "plateau_lags": rand[eq][1], "fixed_b": rand[eq][2],
+                        "plateau_lags": rand[eq][1],
                         "segment_samples": [int(b) for b in np.diff(bnd)]}
             for k, v in zip(ft.terms, ft.sigma()):
                 if k in ship.linear:
@@ -367,7 +351,7 @@ def identify_records(paths, structure: str | None = None, select: bool = True, h
             "intervals_checked": list(ship.linear),
             "intervals_note": "coverage measured for the linear derivatives only (benchmarks/campaign_identification.py); "
                               "the cubic terms trade off against one another and their intervals are not calibrated",
-            "interval": "95 %: ±1.96 σ; σ² = Newey–West (HAC) variance of the equation-error regression at the "
-                        "bandwidth where it levels off (from Andrews' 1991 AR(1) rule up, doubling, to a quarter of the "
-                        "shortest maneuver), widened by the fixed-b factor (Kiefer & Vogelsang 2005), + the record-wide "
-                        "errors' variance (gyro zero, rudder synchro calibration and clock; GUM sensitivities)"}
+            "interval": "95 %: ±1.96 σ; σ² = the largest Newey–West (HAC) variance of the equation-error regression "
+                        "over the bandwidths 0–400 samples (up to a quarter of the shortest maneuver) and Andrews' (1991) "
+                        "AR(1) rule's: its plateau, + the record-wide errors' variance (gyro zero, rudder synchro "
+                        "calibration and clock; GUM sensitivities)"}

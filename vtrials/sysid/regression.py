@@ -155,6 +155,20 @@ def hac_sigmas(A, y, coef, bounds, lags_list) -> dict:
     return out
 
 
+def plateau_sigma(A, y, coef, bounds, ladder) -> tuple[np.ndarray, dict]:
+    """The largest Newey–West σ of each coefficient over the bandwidths of ``ladder`` (those up to a
+    quarter of the shortest segment) and Andrews' (:func:`andrews_lags`); also {bandwidth: σ}. For
+    residuals that mix white noise with a slow error, the AR(1) plug-in sees the white part's lag-1
+    correlation and picks too short a bandwidth; the σ levels off once the bandwidth spans the slow
+    error's correlation (and falls beyond only through the Bartlett window's bias): its plateau."""
+    A = np.asarray(A, float)
+    e = np.asarray(y, float) - A @ coef
+    cap = max(1, int(np.diff(bounds).min()) // 4)
+    lad = [int(L) for L in ladder if L <= cap]
+    sig = hac_sigmas(A, y, coef, bounds, sorted(set(lad + [andrews_lags(e, bounds)])))
+    return np.max(np.array(list(sig.values())), axis=0), sig
+
+
 def _lag1(e, bounds) -> float:
     """Lag-1 autocorrelation of residuals pooled within segments (never across a boundary)."""
     num = sum(float(np.dot(e[a + 1:b], e[a:b - 1])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a > 1)
