@@ -156,6 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="records of maneuvers to predict (not fitted): turning circles and zig-zags")
     idf.add_argument("--all-terms", action="store_true",
                      help="predict with every term of the structure (default: the stepwise-selected terms)")
+    idf.add_argument("--refine", choices=("none", "oe"), default="none",
+                     help="oe: also refine the equation-error coefficients by output error (Levenberg–Marquardt fit "
+                          "of the model's simulated u, v, r, heading to the smoothed ones; MMG model), reported beside them")
     idf.add_argument("--no-score", action="store_true", help="reduce only; do not compare with the truth")
     return p
 
@@ -165,7 +168,7 @@ def _identify(args) -> int:
     from vtrials.runner.staging import check_out, staged_output
     from vtrials.sysid.identify import identify_records
     check_out(args.out)
-    doc = identify_records(args.records, args.model, not args.all_terms, args.held_back)
+    doc = identify_records(args.records, args.model, not args.all_terms, args.held_back, refine=args.refine)
     if not args.no_score:
         from vtrials.score.identification import score
         doc["score"] = score(doc)
@@ -182,6 +185,16 @@ def _identify(args) -> int:
             sc = doc.get("score", {}).get("coefficients", {}).get(k)
             tail = f"   truth {sc['truth']:+.5g} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
             print(f"  {k:<5} {c['value']:+.5g}  95 % [{c['lo95']:+.5g}, {c['hi95']:+.5g}]{tail}")
+    if "output_error" in doc:
+        o = doc["output_error"]
+        print(f"  output error (LM, {o['nfev']} evaluations): weighted RMS {o['rms_weighted']['start']:.3f} → "
+              f"{o['rms_weighted']['refined']:.3f}")
+        for k in doc["intervals_checked"]:
+            c = o["coefficients"].get(k)
+            if c:
+                sc = doc.get("score", {}).get("output_error", {}).get("coefficients", {}).get(k)
+                tail = f"   truth {sc['truth']:+.5g} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
+                print(f"  {k:<5} {c['value']:+.5g}  95 % [{c['lo95']:+.5g}, {c['hi95']:+.5g}]{tail}  (output error)")
     for p in doc["predictions"]:
         print(f"  predicted {p['name']}: " + ", ".join(f"{k} {v:.3g}" for k, v in p["predicted"].items()))
     if "score" in doc:
