@@ -429,7 +429,8 @@ def reduce_maneuvering(rec: Record) -> dict:
                                      t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
                                      rudder=w.get("rudder"), t_rudder=w.get("t_rudder"), approach_s=approach,
                                      steady=sw, current=current_at(r["t_execute"]), roll_bias=ch.roll_bias,
-                                     fix_errors=ch.fix_errors, timing_sd=ch.timing_sd(r["t_execute"]))
+                                     fix_errors=ch.fix_errors, timing_sd=ch.timing_sd(r["t_execute"]),
+                                     t_finex=r["t_finex"], gyro_drift=ch.gyro_drift)
         except (ValueError, np.linalg.LinAlgError) as exc:
             out_runs.append({"run": r["run"], "type": "turn", "error": str(exc)})
             continue
@@ -461,7 +462,8 @@ def reduce_maneuvering(rec: Record) -> dict:
                                          approach_s=r["t_execute"] - r["t_comex"], steady=res0.steady, drift=(dn, de),
                                          sigma_fix=ch.sigma_fix, current=current_at(r["t_execute"]),
                                          roll_bias=ch.roll_bias, fix_errors=ch.fix_errors,
-                                         timing_sd=ch.timing_sd(r["t_execute"]))
+                                         timing_sd=ch.timing_sd(r["t_execute"]), t_finex=r["t_finex"],
+                                         gyro_drift=ch.gyro_drift, loop_drift=res0.drift)
             except (ValueError, np.linalg.LinAlgError):
                 continue
             own = d.get("drift")
