@@ -94,7 +94,8 @@ import numpy as np
 from scipy import optimize, stats
 
 from vtrials.reduce.estimate import Estimate
-from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation, slope_variance
+from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation, slope_variance, \
+    correlated_variance
 
 TWO_PI = 2.0 * math.pi
 
@@ -245,6 +246,17 @@ def fit_circle(x, y) -> tuple[np.ndarray, np.ndarray, float]:
     return p, cov, math.sqrt(s2)
 
 
+def _circle_radius_weights(x, y, p) -> tuple[np.ndarray, np.ndarray]:
+    """Weights h with δR = Σ h_k δρ_k for small radial errors δρ_k of the points (x_k, y_k) about the
+    fitted circle p = (cx, cy, R) (row R of the Gauss–Newton pseudo-inverse), and the points' polar
+    angles about the centre [rad]."""
+    dx, dy = np.asarray(x, float) - p[0], np.asarray(y, float) - p[1]
+    d = np.hypot(dx, dy)
+    J = np.column_stack([-dx / d, -dy / d, -np.ones_like(d)])
+    H = np.linalg.pinv(J.T @ J) @ J.T
+    return -H[2], np.arctan2(dy, dx)
+
+
 def _circ_mean(a: np.ndarray) -> tuple[float, float]:
     """Circular mean of angles [rad] and its standard error (lag-1 corrected)."""
     c, s = np.mean(np.cos(a)), np.mean(np.sin(a))
@@ -372,13 +384,16 @@ def steady_window(t_heading, heading, t_execute: float, *, tol: float = 0.02,
 
 # ------------------------------------------------------------------------------------------- drift
 def drift_from_pairs(t, north, east, t_start: float, t_end: float, period: float,
-                     period_std: float = 0.0, *, min_pairs: int = 5) -> Drift:
+                     period_std: float = 0.0, *, min_pairs: int = 5, fix_errors=()) -> Drift:
     """Drift velocity [m/s] from positions one steady turning period [s] (360° of heading) apart.
 
     Pairs (t_i, t_i + period) for every tracking sample t_i ∈ [t_start, t_end − period]; the partner
     position is a 4-point Lagrange interpolation. Returns the mean of the pair drifts with the
     pair-scatter standard error described in the module docstring (``detail['se_batch_*']`` holds a
-    batch-means SE over ≤ 10 blocks of consecutive pairs as a diagnostic).
+    batch-means SE over ≤ 10 blocks of consecutive pairs as a diagnostic). ``fix_errors``: the
+    tracking's time-correlated errors per axis, (sd [m], τ [s]) pairs: a wander slower than the
+    period moves every pair alike, so the pair scatter cannot see it; its variance in the mean drift
+    is propagated through the same sample weights (:func:`vtrials.reduce.series.correlated_variance`).
     """
     t, n_, e_ = _clean(t, north, east)
     T = float(period)
@@ -413,7 +428,8 @@ def drift_from_pairs(t, north, east, t_start: float, t_end: float, period: float
     # per-axis noise variance implied by the pair scatter
     s2N = T ** 2 * float(np.sum((dN - DN) ** 2)) / float(np.sum(cmult)) * npair / (npair - 1)
     s2E = T ** 2 * float(np.sum((dE - DE) ** 2)) / float(np.sum(cmult)) * npair / (npair - 1)
-    cov = np.diag([s2N * sum_a2, s2E * sum_a2])
+    s2c = correlated_variance(t, a, fix_errors)
+    cov = np.diag([s2N * sum_a2 + s2c, s2E * sum_a2 + s2c])
     # period error: mean water velocity at the partner points
     t1, t2 = t[rows[0][0]] + T, t[rows[-1][0]] + T
     if t2 - t1 > 0 and period_std > 0:
@@ -547,7 +563,7 @@ def drift_from_circle_fit(t, north, east, t_start: float, t_end: float, omega0: 
 
 
 def estimate_drift(t, north, east, t_heading, heading, t_execute: float, *, method: str = "auto",
-                   steady: SteadyWindow | None = None, **steady_kw) -> tuple[Drift, SteadyWindow]:
+                   steady: SteadyWindow | None = None, fix_errors=(), **steady_kw) -> tuple[Drift, SteadyWindow]:
     """Drift of a tactical circle. ``method``: 'pairs' (seed 002, used by the report), 'heading_pairs',
     'circle' (moving-centre fit) or 'auto' (pairs; the circle fit when the steady part has fewer than
     5 pairs). Returns the drift and the steady window used."""
@@ -557,7 +573,7 @@ def estimate_drift(t, north, east, t_heading, heading, t_execute: float, *, meth
     T_std = TWO_PI * r.std / r.value ** 2 if math.isfinite(r.std) else 0.0
     if method in ("pairs", "auto"):
         try:
-            return drift_from_pairs(t, north, east, sw.t_start, sw.t_end, T, T_std), sw
+            return drift_from_pairs(t, north, east, sw.t_start, sw.t_end, T, T_std, fix_errors=fix_errors), sw
         except ValueError:
             if method == "pairs":
                 raise
@@ -787,7 +803,8 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     drift_obj: Drift | None
     if isinstance(drift, str):
         try:
-            drift_obj, _ = estimate_drift(tp, N, E, th, psi, t_execute, method=drift, steady=sw)
+            drift_obj, _ = estimate_drift(tp, N, E, th, psi, t_execute, method=drift, steady=sw,
+                                          fix_errors=fix_errors)
             if drift_obj.method == "circle" and drift == "auto":
                 notes.append("drift from the moving-circle fit (steady part too short for 360-deg pairs)")
         except (ValueError, np.linalg.LinAlgError) as exc:
@@ -905,7 +922,12 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         Nl, El = drift_corrected_track(tp, N, E, t_execute, ld) if ld is not None else (N, E)
         p, cov, rms = fit_circle(Nl[ms], El[ms])
         R = float(p[2])
-        varR = float(cov[2, 2])
+        # the radius is a linear functional of the radial position errors (Gauss–Newton at the
+        # solution): white tracking noise σ_p and the tracking's time-correlated errors; the fit's own
+        # residual scatter would also count the wind's non-circularity of the loop, which the
+        # reference shares
+        h, theta_k = _circle_radius_weights(Nl[ms], El[ms], p)
+        varR = 0.5 * (sigN ** 2 + sigE ** 2) * float(h @ h) + correlated_variance(tp[ms], h, fix_errors, theta_k)
         if ld is not None and np.any(Sl > 0):
             g = np.zeros(2)
             for j in range(2):
