@@ -71,7 +71,8 @@ from scipy import sparse
 from scipy.interpolate import BSpline
 
 from vtrials.reduce.estimate import Estimate
-from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_inflation as _ar1_inflation, slope_variance
+from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_inflation as _ar1_inflation, slope_variance, \
+    correlated_variance
 
 
 # --------------------------------------------------------------------------------------------- helpers
@@ -265,6 +266,15 @@ class PSpline:
         C = self.W @ (f * Z)
         edf = f.sum(axis=0)
         return (C[:, 0], float(edf[0])) if one else (C, edf)
+
+    def weights(self, g, y, sigma, gamma) -> np.ndarray:
+        """Weights w (n,) of the data with g·coef = w·y for the fit of data column y (λ chosen for y as
+        in :meth:`fit`), g (m,) a row of basis values: the fitted value's linear dependence on the data."""
+        y = np.asarray(y, float)
+        Z = self.W.T @ (self.B.T @ y)
+        rss = float(y @ y) - 2 * (self.F @ (Z * Z)) + (self.F ** 2) @ (Z * Z)
+        j = int(np.argmin(rss + 2 * gamma * sigma ** 2 * self.F.sum(axis=1)))
+        return np.asarray(self.B @ (self.W @ (self.F[j] * (self.W.T @ np.asarray(g, float))))).ravel()
 
     def design(self, tg):
         """Basis values and first derivatives at tg: sparse (G0, G1), each (len(tg), m)."""
@@ -488,6 +498,9 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
     moving = abs(U0_along) > max(3 * math.sqrt((uvec[0] * sbN) ** 2 + (uvec[1] * sbE) ** 2 + var_fix_app
                                                + var_drift_u), 0.05)
     G0, G1 = basis.design(tg)
+
+    def G0_at(tq):
+        return basis.design(np.array([tq]))[0].toarray()
     # linear functional giving the approach-line value at EXECUTE from the data vector
     m_app = (tf <= t_execute)
     xa = tf[m_app] - tf[m_app].mean()
@@ -570,20 +583,47 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
                       terminal_reached=terminal_reached,
                       band=base["band"], dead_in_water="t_diw" in base, sigma_position=(sig_s, sig_y),
                       n_boot=n_boot, notes=notes)
+    vel = None
+    if velocity is not None:
+        tv, vN, vE = (np.asarray(x, float) for x in velocity)
+        ok = np.isfinite(tv) & np.isfinite(vN) & np.isfinite(vE) & (tv >= t_execute - approach_s) & (tv <= t_end)
+        tv, vN, vE = tv[ok], vN[ok], vE[ok]
+        if drift is not None:
+            vN, vE = vN - dn, vE - de
+        if tv.size >= 20:
+            psi_v = np.interp(tv, th, hd) if hd is not None else np.full(tv.size, psi0)
+            u_v = vN * np.cos(psi_v) + vE * np.sin(psi_v)  # surge through the water
+            vel = (tv, u_v, np.where(u_v >= 0, 1.0, -1.0) * np.hypot(vN, vE))
     if "t_diw" in base:
         td = base["t_diw"]
-        el = td - t_execute
         sD_u = math.sqrt(float(uvec @ SD @ uvec))
         sD_n = math.sqrt(float(nvec @ SD @ nvec))
         sd_t = math.sqrt(bstd("t_diw") ** 2 + (sD_u / max(abs(base["udot_diw"]), 1e-9)) ** 2 + timing_sd ** 2)
+        s_d, y_d, path_d = base["s_diw"], base["y_diw"], base["path_diw"]
+        # with the receiver's velocity: DIW where its surge through the water crosses zero (the
+        # smoothed position fit rounds the deceleration); the drift error moves the surge by its
+        # component along the heading
+        cr = velocity_crossing(vel[0], vel[1], 0.0, -1.0 if U0_along >= 0 else 1.0, t_execute) if vel else None
+        if cr is not None:
+            td = cr[0]
+            sd_t = math.sqrt(cr[1] ** 2 + (sD_u / abs(cr[2])) ** 2 + timing_sd ** 2)
+            s_d, y_d, path_d = (float(np.interp(td, tg, base[k])) for k in ("s", "y", "path"))
+            notes.append("dead in the water on the receiver's velocity (Doppler)")
+        el = td - t_execute
         s_clk = U0 * timing_sd
-        s_d, y_d = base["s_diw"], base["y_diw"]
+        # the tracking's time-correlated errors (DGPS wander, multipath) between the EXECUTE point (the
+        # approach line) and the fit at DIW: the bootstrap of white residuals does not see them
+        var_cs = var_cy = 0.0
+        if fix_errors:
+            g0 = np.asarray(G0_at(td)).ravel()
+            var_cs = correlated_variance(tf, basis.weights(g0, s_raw, sig_s, 1.0) - le, fix_errors)
+            var_cy = correlated_variance(tf, basis.weights(g0, y_raw, sig_y, 1.0) - le, fix_errors)
         res.time_to_dead_in_water = Estimate(el, sd_t, dof)
         res.head_reach = Estimate(s_d, math.sqrt(bstd("s_diw") ** 2 + (y_d * psi0_se) ** 2 + (el * sD_u) ** 2
-                                                 + s_clk ** 2))
+                                                 + s_clk ** 2 + var_cs))
         res.lateral_deviation = Estimate(y_d, math.sqrt(bstd("y_diw") ** 2 + (s_d * psi0_se) ** 2
-                                                        + (el * sD_n) ** 2))
-        res.track_reach = Estimate(base["path_diw"], math.sqrt(bstd("path_diw") ** 2 + (el * sD_u) ** 2 + s_clk ** 2))
+                                                        + (el * sD_n) ** 2 + var_cy))
+        res.track_reach = Estimate(path_d, math.sqrt(bstd("path_diw") ** 2 + (el * sD_u) ** 2 + s_clk ** 2 + var_cs))
         n_ok = len(reps["t_diw"])
         if n_boot and n_ok < 0.9 * n_boot:
             notes.append(f"DIW found in only {n_ok} of {n_boot} bootstrap replicates")
@@ -600,17 +640,9 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         res.track_distance_at_terminal = Estimate(base["path_term"],
                                                   math.sqrt(bstd("path_term") ** 2 + (el * sD_u) ** 2))
     t90_v = None
-    if velocity is not None and abs(base["UT"] - U0) > 0:
-        tv, vN, vE = (np.asarray(x, float) for x in velocity)
-        ok = np.isfinite(tv) & np.isfinite(vN) & np.isfinite(vE) & (tv >= t_execute - approach_s) & (tv <= t_end)
-        tv, vN, vE = tv[ok], vN[ok], vE[ok]
-        if drift is not None:
-            vN, vE = vN - dn, vE - de
-        if tv.size >= 20:
-            psi_v = np.interp(tv, th, hd) if hd is not None else np.full(tv.size, psi0)
-            Uv = np.where(vN * np.cos(psi_v) + vE * np.sin(psi_v) >= 0, 1.0, -1.0) * np.hypot(vN, vE)
-            level = U0 + 0.9 * (base["UT"] - U0)
-            t90_v = velocity_crossing(tv, Uv, level, 1.0 if base["UT"] > U0 else -1.0, t_execute)
+    if vel is not None and abs(base["UT"] - U0) > 0:
+        level = U0 + 0.9 * (base["UT"] - U0)
+        t90_v = velocity_crossing(vel[0], vel[2], level, 1.0 if base["UT"] > U0 else -1.0, t_execute)
     if t90_v is not None:
         # the level U0 + 0.9 (UT − U0) carries the two speeds' errors, less the drift's, which moves
         # the measured velocities alike; the crossing moves by that over the acceleration there
