@@ -52,8 +52,8 @@ MSC/Circ.1053 definitions of advance, transfer and tactical diameter):
    −1.1 m, 43 % covered). On the loop: steady turning diameter = geometric least-squares circle
    fitted to the track less the circle's OWN drift (``loop_drift``: each loop is closed by its own
    drift, as ITTC's drift correction does; the day's mean drift leaves the side-dependent leeway of the
-   circling ship in the track, and an open loop of a drifting circle fits a larger circle, by
-   ≈ (drift·T)²/(8R)), steady rate of turn = 360° / (time for the loop) (the mean rate of change of
+   circling ship in the track, and the circle fitted to an open loop of a drifting circle is off by
+   up to drift·T/(2π) in radius, depending on where the loop starts), steady rate of turn = 360° / (time for the loop) (the mean rate of change of
    heading; in wind the rate varies around the loop and an OLS slope depends on where the loop
    starts), steady speed U = R·|r_ss| (circumference / time for the loop), drift angle β = ψ − χ
    (heading minus the tangent direction of the fitted circle at each sample, positive bow-in).

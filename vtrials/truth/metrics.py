@@ -63,8 +63,8 @@ def turning(t, x_w, y_w, heading, u_r, v_r, r, *, steady_from_deg: float = 360.0
     change (the last 360° recorded if the turn is shorter; ends at the interpolated crossings):
     steady turning diameter = least-squares circle fitted to the water track less the loop's own drift
     (its displacement between the loop's ends over the loop's duration — the wind's leeway of the
-    circling ship, which ITTC 7.5-04-02-01's drift correction removes loop by loop; an open loop fits
-    a larger circle); steady rate of turn = heading change over the loop / its duration (the mean rate
+    circling ship, which ITTC 7.5-04-02-01's drift correction removes loop by loop; a circle fitted
+    to the open loop is off by up to drift·T/(2π) in radius, depending on where the loop starts); steady rate of turn = heading change over the loop / its duration (the mean rate
     of change of heading, as the independent MMG reference of the tests defines it: ∫|r|dt / T);
     steady speed = mean speed through the water over the loop.
     """
