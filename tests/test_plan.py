@@ -22,7 +22,7 @@ from vtrials.plan.spec import load_plan
 
 DATA = Path(__file__).resolve().parent / "data"
 PLAN = DATA / "plan_short.toml"
-SHIPPED = Path(__file__).resolve().parents[1] / "scenarios" / "plan_patrol51_standardization.toml"
+SHIPPED = Path(__file__).resolve().parents[1] / "scenarios" / "plans" / "plan_patrol51_standardization.toml"
 
 
 def _edit(tmp_path, old: str, new: str) -> Path:

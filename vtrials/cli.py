@@ -120,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
                                "value; [target] quantity (speed | power), rpm/pitch or order, tolerance, "
                                "confidence, rule (quantile | wilson); [limits] max_hours, max_wind_kn; "
                                "[candidates] spots, runs, run_s, neighbours, turn_s, setting_change_s. "
-                               "See vtrials/plan/spec.py and scenarios/plan_patrol51_standardization.toml.")
+                               "See vtrials/plan/spec.py and scenarios/plans/plan_patrol51_standardization.toml.")
     pl.add_argument("plan", metavar="PLAN", help="plan file (TOML)")
     pl.add_argument("--out", metavar="DIR", required=True, help="output directory (an unfinished plan there resumes)")
     pl.add_argument("--replicates", type=int, metavar="N", help="replicates per search campaign (default: the plan's)")
