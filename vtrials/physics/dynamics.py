@@ -567,7 +567,8 @@ _LOOPS: dict[str, tuple] = {}
 
 
 def step_loops(component_types: list) -> tuple:
-    """(serial, threaded) multi-step loops (:func:`_run_steps`) around :func:`step_kernels`' kernels."""
+    """(serial, threaded) multi-step loops (:func:`_run_steps`) around :func:`step_kernels`' kernels; they
+    release the GIL (the simulator's shards run the serial one in several Python threads at once)."""
     serial, threaded = step_kernels(component_types)
     _, tag = registry.dispatcher(list(component_types))
     if tag not in _LOOPS:
@@ -575,6 +576,6 @@ def step_loops(component_types: list) -> tuple:
         for kern, name in ((serial, f"_run_steps_{tag}"), (threaded, f"_run_steps_parallel_{tag}")):
             g = dict(_run_steps.__globals__)
             g["_step_kernel"] = kern
-            loops.append(nb.njit(cache=True)(_twin(_run_steps, name, g)))
+            loops.append(nb.njit(cache=True, nogil=True)(_twin(_run_steps, name, g)))
         _LOOPS[tag] = tuple(loops)
     return _LOOPS[tag]

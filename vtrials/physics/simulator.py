@@ -36,7 +36,44 @@ from vtrials.physics.vessel import Vessel
 
 
 PARALLEL_FROM = 8  # batches at least this large use the threaded kernel (when nthread > 1)
+# runs of at least this many ship-steps go to the shards (one Python thread each, see _Shard); shorter
+# runs to the threaded kernel and the whole batch (handing a run to threads costs ~0.1 ms)
+SHARD_FROM = 256
 _HOOK_IDS = itertools.count()
+
+
+class _Shard:
+    """Ships a…b−1 of a threaded simulator in a one-thread ``mujoco.batch`` of their own.
+
+    A run of steps copies the ships' MuJoCo state rows (time, qpos, qvel, …: everything a step reads)
+    into the shard's batch, steps them there with the serial step loop on the shard's rows of every
+    per-ship array, and copies the rows back. Each shard runs in its own Python thread (the compiled
+    loop and MuJoCo's step release the GIL), so the threads meet once per run rather than twice per
+    step (the threaded kernel's ``prange`` and the batch's own pool). A step of a ship reads only its
+    own row and arrays, so the results are those of the whole batch, bit for bit.
+    """
+
+    def __init__(self, model, a: int, b: int, rec_width: int):
+        self.a, self.b = int(a), int(b)
+        self.batch = mjbatch.Batch(model, self.b - self.a, nthread=1)
+        self.state = self.batch.state
+        self.qpos = self.batch.bind("qpos")
+        self.qvel = self.batch.bind("qvel")
+        self.qfrc = self.batch.bind("qfrc_applied")
+        self.time = self.batch.bind("time")
+        self.wcount = self.batch.warning[:, :, 1]
+        self.no_rec = np.zeros((1, self.b - self.a, rec_width))
+        self.rec = self.no_rec
+        self._hook_error = None
+        self.hook_id = next(_HOOK_IDS)
+        DY._HOOKS[self.hook_id] = weakref.ref(self)
+        weakref.finalize(self, DY._HOOKS.pop, self.hook_id, None)
+
+    def rec_rows(self, rows: int) -> np.ndarray:
+        """A contiguous buffer of at least ``rows`` truth rows of the shard's ships."""
+        if self.rec is self.no_rec or self.rec.shape[0] < rows:
+            self.rec = np.zeros((max(rows, 1), self.b - self.a, self.no_rec.shape[2]))
+        return self.rec
 
 
 @dataclasses.dataclass
@@ -184,6 +221,14 @@ class Simulator:
         self._kernel = threaded if threads else serial
         # whole runs of steps in one compiled call (kernel + the batch's step through a hook)
         self._loop = DY.step_loops(self.comp_types)[1 if threads else 0]
+        # long runs of many ships: one shard per thread (see _Shard)
+        self._shards: list[_Shard] = []
+        self._pool = None
+        if threads:
+            self._loop_serial = DY.step_loops(self.comp_types)[0]
+            cuts = [round(k * self.n / nthread) for k in range(nthread + 1)]
+            self._shards = [_Shard(model, a, b, DY.record_width(self.nr, self.ns, len(comps)))
+                            for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
         self._hook_id = next(_HOOK_IDS)
         self._hook_error = None
         DY._HOOKS[self._hook_id] = weakref.ref(self)
@@ -410,14 +455,10 @@ class Simulator:
                         self._new_chunk()
                     rec = self._chunk
                     m = min(left, first + (rec.shape[0] - self._krow) * every)
-            done, krow, code = self._loop(
-                m, every, self._step_count, self._krow, self._hook_id, self._wcount,
-                self.dt, self.qpos, self.qvel, self.time, self.qfrc,
-                self.comp_kind, self.comp_off, self.comp_par, self.comp_soff, self.comp_st, self.minv, self.mrb,
-                self.ma, self.coriolis_mode, self.rb, self.steer, self.shaftp, self.env,
-                self.rud_cmd, self.shaft_cmd, self.pitch_cmd, self.shaft_mode, self.mach, self.nav,
-                self.phases, self.hs, self.events, self.ecount,
-                self.ctx, self.aux, self.comp_w, self.nudot, self.limits, self.status, rec, self.scratch)
+            if self._shards and m * self.n >= SHARD_FROM:
+                done, krow, code = self._run_shards(m, every, rec)
+            else:
+                done, krow, code = self._run(self._loop, m, every, rec)
             self._step_count += done
             self._krow = krow
             left -= done
@@ -430,6 +471,66 @@ class Simulator:
                 raise exc
             elif code == DY.STOP_WARNING:
                 self._raise_mujoco(int(np.flatnonzero(self._wcount.any(axis=1))[0]), None)
+
+    def _run(self, loop, m, every, rec):
+        """``m`` steps of the whole batch in one call of ``loop``: (done, next row, code)."""
+        return loop(
+                m, every, self._step_count, self._krow, self._hook_id, self._wcount,
+                self.dt, self.qpos, self.qvel, self.time, self.qfrc,
+                self.comp_kind, self.comp_off, self.comp_par, self.comp_soff, self.comp_st, self.minv, self.mrb,
+                self.ma, self.coriolis_mode, self.rb, self.steer, self.shaftp, self.env,
+                self.rud_cmd, self.shaft_cmd, self.pitch_cmd, self.shaft_mode, self.mach, self.nav,
+                self.phases, self.hs, self.events, self.ecount,
+                self.ctx, self.aux, self.comp_w, self.nudot, self.limits, self.status, rec, self.scratch)
+
+    # what a step changes besides the MuJoCo state and the truth rows (the event log is appended
+    # at ecount, so restoring ecount restores it); a run of the shards that stops is redone from these
+    _RUN_STATE = ("comp_st", "rud_cmd", "mach", "nav", "hs", "ecount", "ctx", "aux")
+
+    def _run_shards(self, m, every, rec):
+        """``m`` steps on the shards, each in a thread of its own (see :class:`_Shard`).
+
+        When every shard completes the run, its rows go back to the batch. When one stops (a ship's
+        status, a MuJoCo error or warning), the others have run past the step where the whole batch
+        stops; the run is then undone and done again on the whole batch, which stops where the
+        plain loop does, with its message.
+        """
+        if self._wcount.any():  # a warning left from before: the whole batch stops at once, as before
+            return self._run(self._loop, m, every, rec)
+        saved = [self.batch.state.copy()] + [getattr(self, k).copy() for k in self._RUN_STATE]
+        rows = 0 if rec is self._no_rec else len(range((-self._step_count) % every, m, every))
+        calls = []
+        for sh in self._shards:
+            a, b = sh.a, sh.b
+            sh.state[...] = self.batch.state[a:b]
+            srec = sh.no_rec if rec is self._no_rec else sh.rec_rows(rows)
+            calls.append((m, every, self._step_count, 0, sh.hook_id, sh.wcount,
+                          self.dt, sh.qpos, sh.qvel, sh.time, sh.qfrc,
+                          self.comp_kind, self.comp_off, self.comp_par[a:b], self.comp_soff, self.comp_st[a:b],
+                          self.minv[a:b], self.mrb[a:b], self.ma[a:b], self.coriolis_mode, self.rb[a:b], self.steer,
+                          self.shaftp, self.env[a:b], self.rud_cmd[a:b], self.shaft_cmd[a:b], self.pitch_cmd[a:b],
+                          self.shaft_mode[a:b], self.mach[a:b], self.nav[a:b], self.phases[a:b], self.hs[a:b],
+                          self.events[a:b], self.ecount[a:b], self.ctx[a:b], self.aux[a:b], self.comp_w[a:b],
+                          self.nudot[a:b], self.limits, self.status[a:b], srec, self.scratch[a:b]))
+        if self._pool is None:
+            from concurrent.futures import ThreadPoolExecutor
+            self._pool = ThreadPoolExecutor(max_workers=len(self._shards) - 1, thread_name_prefix="vtrials-shard")
+            weakref.finalize(self, self._pool.shutdown, wait=False)
+        futures = [self._pool.submit(self._loop_serial, *c) for c in calls[1:]]
+        results = [self._loop_serial(*calls[0])] + [f.result() for f in futures]
+        if all(r[0] == m and r[2] == 0 for r in results):
+            for sh in self._shards:
+                self.batch.state[sh.a:sh.b] = sh.state
+                if rows:
+                    rec[self._krow:self._krow + rows, sh.a:sh.b] = sh.rec[:rows]
+            return m, self._krow + rows, 0
+        self.batch.state[...] = saved[0]
+        for k, arr in zip(self._RUN_STATE, saved[1:]):
+            getattr(self, k)[...] = arr
+        for sh in self._shards:
+            sh.wcount[...] = 0
+            sh._hook_error = None
+        return self._run(self._loop, m, every, rec)
 
     def _raise_mujoco(self, i: int, text: str | None):
         """A MuJoCo warning (its warning counters rose) or error in ship i: stop with the time and state."""
