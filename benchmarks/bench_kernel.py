@@ -168,6 +168,7 @@ def measure(ship, sea, n, nthread, rounds, seconds, task="CourseKeeping"):
         state = sim.batch.state.copy()
         rates["batch"].append(_rate(sim.batch.step, seconds) * n)
         sim.batch.state[:] = state  # the batch alone (stale forces) would drift away
+        sim.batch.warning[...] = 0  # and may have raised MuJoCo's warnings on the way
         keep = [a.copy() for a in (sim.nav, sim.mach, sim.hs, sim.events, sim.ecount, sim.rud_cmd, sim.comp_st)]
         rates["kernel"].append(_rate(kernel, seconds) * n)
         sim.batch.state[:] = state

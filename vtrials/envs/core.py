@@ -60,6 +60,35 @@ class SeaRanges:
     spreading_s: float = 10.0  # cos-2s exponent of a wind sea (Goda 1985)
 
 
+class Tracks:
+    """Each ship's positions (north, east) [m] at its episode's control instants: ``tracks[i]`` is ship
+    i's (k, 2) array (a view; the wake the renderer draws)."""
+
+    def __init__(self, n: int, capacity: int):
+        self.xy = np.zeros((n, max(int(capacity), 1), 2))
+        self.count = np.zeros(n, dtype=np.int64)
+
+    def __len__(self) -> int:
+        return self.count.shape[0]
+
+    def __getitem__(self, i: int) -> np.ndarray:
+        return self.xy[i, :self.count[i]]
+
+    def clear(self, idx) -> None:
+        self.count[idx] = 0
+
+    def append(self, idx: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
+        """One position for each ship of ``idx`` (distinct ships)."""
+        k = self.count[idx]
+        if k.size and k.max() >= self.xy.shape[1]:  # an episode longer than foreseen: room for twice as many
+            grown = np.zeros((self.xy.shape[0], 2 * self.xy.shape[1], 2))
+            grown[:, :self.xy.shape[1]] = self.xy
+            self.xy = grown
+        self.xy[idx, k, 0] = x
+        self.xy[idx, k, 1] = y
+        self.count[idx] = k + 1
+
+
 class ShipBatch:
     """``n`` ships of ``ship`` doing ``task`` in the sea state ``sea``.
 
@@ -144,7 +173,7 @@ class ShipBatch:
         self.meas = np.zeros((self.n, len(CHANNELS)))
         self.truth = {}
         self.drawn = [dict() for _ in range(self.n)]
-        self.track: list[list] = [[] for _ in range(self.n)]  # truth positions at control instants (wake)
+        self.track = Tracks(self.n, self.max_steps + 1)  # truth positions at control instants (wake)
 
     # ------------------------------------------------------------------ set-up helpers
     def _steady_state(self, order: str) -> ShipState:
@@ -254,7 +283,7 @@ class ShipBatch:
             self.steps[i] = 0
             self.act_prev[i] = (0.0, self.lever_of(order))
             self.drawn[i] = {"order": order, **sea}
-            self.track[i] = []
+        self.track.clear(idx)
         self._observe(idx, first=True)
 
     def _read_truth(self) -> dict:
@@ -273,12 +302,14 @@ class ShipBatch:
 
     def _observe(self, idx: np.ndarray, first: bool = False) -> None:
         truth = self._read_truth()
-        sub = {k: a[idx] for k, a in truth.items()}
+        every = idx.size == self.n and np.array_equal(idx, np.arange(self.n))
+        # all ships (every step): the arrays themselves rather than copies gathered by index
+        rows = slice(None) if every else idx
+        sub = truth if every else {k: a[idx] for k, a in truth.items()}
         m = self.obs_model.sample(sub, idx)
-        self.meas[idx] = m
-        for i in idx:
-            self.track[i].append((truth["x"][i], truth["y"][i]))
-        U0 = self.task.U0[idx]
+        self.meas[rows] = m
+        self.track.append(idx, truth["x"][rows], truth["y"][rows])
+        U0 = self.task.U0[rows]
         f = np.empty((idx.size, self.n_feat))
         f[:, 0] = np.sin(m[:, 0])
         f[:, 1] = np.cos(m[:, 0])
@@ -287,14 +318,15 @@ class ShipBatch:
         f[:, 4] = m[:, 4] / U0
         f[:, 5] = m[:, 6] / self.delta_max
         f[:, 6] = m[:, 7] / self.n_full
-        f[:, 7:9] = self.act_prev[idx]
+        f[:, 7:9] = self.act_prev[rows]
         f[:, N_COMMON:] = self.task.features(m, idx)
         f = np.clip(f, -50.0, 50.0).astype(np.float32)
         if first:
-            self.frames[idx] = f[:, None, :]
+            self.frames[rows] = f[:, None, :]
         else:
-            self.frames[idx, :-1] = self.frames[idx, 1:]
-            self.frames[idx, -1] = f
+            if self.stack > 1:
+                self.frames[rows, :-1] = self.frames[rows, 1:]
+            self.frames[rows, -1] = f
 
     def observations(self) -> np.ndarray:
         return self.frames.reshape(self.n, -1)

@@ -197,14 +197,16 @@ class ObservationModel:
         (len(idx),) at this control instant; advances those ships' sample counters."""
         C = len(CHANNELS)
         idx = np.arange(self.n) if idx is None else np.asarray(idx, dtype=np.int64)
-        kk = self.k[idx]
+        # all ships (every control step): views of the per-ship arrays rather than gathered copies
+        rows = slice(None) if idx.size == self.n and np.array_equal(idx, np.arange(self.n)) else idx
+        kk = self.k[rows]
         k = np.minimum(kk, self.horizon - 1)
         w = self.w[idx, k]  # (n, 2C+1)
         started = (kk > 0)[:, None]
-        gm = np.where(started, self.a * self.gm[idx] + self.b * w[:, C:2 * C], self.gm[idx])
-        self.gm[idx] = gm
-        gm2 = np.where(started, self.a2 * self.gm2[idx] + self.b2 * self.w2[idx, k], self.gm2[idx])
-        self.gm2[idx] = gm2
+        gm = np.where(started, self.a * self.gm[rows] + self.b * w[:, C:2 * C], self.gm[rows])
+        self.gm[rows] = gm
+        gm2 = np.where(started, self.a2 * self.gm2[rows] + self.b2 * self.w2[idx, k], self.gm2[rows])
+        self.gm2[rows] = gm2
         psi, r = truth["psi"], truth["r"]
         c, s = np.cos(psi), np.sin(psi)
         # sensor positions and velocities (rigid-body yaw lever arms)
@@ -215,9 +217,9 @@ class ObservationModel:
         m[:, 0] = psi
         if self.gyro.north_seeking:  # speed error less the corrector's (reading − true)
             m[:, 0] += SE.speed_error(truth["vn"], self.gyro.latitude) - np.where(
-                self.corr_speed[idx] > 0,
-                np.arcsin(np.clip(self.corr_speed[idx] * c / (SE.EARTH_RADIUS * SE.EARTH_RATE
-                                                              * np.cos(self.corr_lat[idx])), -1.0, 1.0)), 0.0)
+                self.corr_speed[rows] > 0,
+                np.arcsin(np.clip(self.corr_speed[rows] * c / (SE.EARTH_RADIUS * SE.EARTH_RATE
+                                                               * np.cos(self.corr_lat[rows])), -1.0, 1.0)), 0.0)
         m[:, 1] = r
         m[:, 2] = truth["x"] + c * xg - s * yg - self.latency * vn
         m[:, 3] = truth["y"] + s * xg + c * yg - self.latency * ve
@@ -225,7 +227,7 @@ class ObservationModel:
         m[:, 5] = truth["u_r"] - r * self.sites["log_speed"][1]
         m[:, 6] = truth["rudder"]
         m[:, 7] = truth["shaft_rps"]
-        y = m * (1.0 + self.scale[idx]) + self.bias[idx] + gm + gm2 + self.noise * w[:, :C]
+        y = m * (1.0 + self.scale[rows]) + self.bias[rows] + gm + gm2 + self.noise * w[:, :C]
         sv = self.noise[4]
         y[:, 4] = np.hypot(vn + sv * w[:, 4], ve + sv * w[:, 2 * C])
         nz = self.res > 0
@@ -235,6 +237,6 @@ class ObservationModel:
         drop = self.drop[idx, k] & (kk > 0)
         if np.any(drop):
             y[drop, 2:5] = self.last[idx[drop], 2:5]
-        self.last[idx] = y
-        self.k[idx] = kk + 1
+        self.last[rows] = y
+        self.k[rows] = kk + 1
         return y
