@@ -8,11 +8,16 @@
   truth rows, states and the stop at a runaway, bit for bit; a failure of the batch's step (reached
   without its Python wrapper) still stops with MuJoCo's message;
 * ``Simulator.kinematics()`` against the context a full force evaluation writes;
+* threaded runs on shards (each shard's ships in a one-thread batch and a Python thread of their own)
+  against the one-thread simulator: states, truth rows and the stop at a runaway in one shard (the run
+  undone and done again on the whole batch), bit for bit; ``set_state(alone=True)`` against the
+  evaluation of every ship;
 * the heading fold of the wave tables against its definition (β = μ − ψ wrapped, mirror for β < 0).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -51,7 +56,7 @@ def test_own_curve_horner_equals_the_term_by_term_sum(ship):
     assert n == 23 * 7
 
 
-def _sim(ship: str, n: int, dt: float, record_every: int = 1) -> Simulator:
+def _sim(ship: str, n: int, dt: float, record_every: int = 1, nthread: int = 1) -> Simulator:
     """n ships in current (with a gradient) and gusty wind, in varied conditions: steady ahead, hard
     over, backing, one shaft locked (twin screws)."""
     v = load_vessel(ship)
@@ -63,7 +68,7 @@ def _sim(ship: str, n: int, dt: float, record_every: int = 1) -> Simulator:
         e = W.pack_env(W.Wind(speed_kn=12.0 + 5 * k, direction_deg=30.0 * k, gust_spectrum="npd",
                               gust_components=32), e, rng)
         envs.append(e)
-    sim = Simulator(v, n, dt, envs=np.stack(envs), record_every=record_every)
+    sim = Simulator(v, n, dt, envs=np.stack(envs), record_every=record_every, nthread=nthread)
     ns = sim.ns
     for i in range(n):
         st = sim.steady_at_order(0, (v.telegraph["full"][0] * (0.5 + 0.1 * i),) * ns)
@@ -162,6 +167,83 @@ def test_batch_failure_through_the_hook_stops_with_mujocos_message():
     msg = str(e.value)
     assert "(ship 1)" in msg and "simulated MuJoCo error in 1" in msg and "MuJoCo raised in 1 of 2" in msg
     assert sim._step_count == 3 and sim._hook_error is None
+
+
+_RUN_ARRAYS = ("qpos", "qvel", "time", "qfrc", "mach", "nav", "comp_st", "rud_cmd", "hs", "ecount", "events", "ctx",
+               "aux", "status")
+
+
+def _counting_shards(sim, counts):
+    run = sim._run_shards
+
+    def counted(*a):
+        counts.append(a[0])
+        return run(*a)
+    sim._run_shards = counted
+
+
+def test_threaded_shards_run_bit_identical_to_one_thread():
+    """16 ships on two shards (runs of ≥ SHARD_FROM ship-steps) and on the threaded kernel (shorter
+    runs), truth rows across runs, against the one-thread simulator."""
+    one, two = _sim("patrol51", 16, 0.02, 3), _sim("patrol51", 16, 0.02, 3, nthread=2)
+    assert [(s.a, s.b) for s in two._shards] == [(0, 8), (8, 16)] and not one._shards
+    counts = []
+    _counting_shards(two, counts)
+    for k in (17, 1, 5, 40, 2, 300):
+        one.step(k)
+        two.step(k)
+    assert counts == [17, 40, 300]  # the runs of 16 × k ≥ 256 ship-steps went to the shards
+    assert np.array_equal(one.truth(), two.truth()) and one.truth().shape == (122, 16, one.rec_width)
+    for name in _RUN_ARRAYS:
+        assert np.array_equal(getattr(one, name), getattr(two, name)), name
+    assert np.ptp(one.truth()[:, 0, 1]) > 1.0  # the ships moved
+
+
+def test_runaway_in_a_shard_stops_where_the_whole_batch_does():
+    """Ship 13 (second shard) runs away: the threaded simulator stops at the step, time and message
+    of the one-thread one, with the same states of every ship (the shards' run undone and redone)."""
+    out = []
+    for nthread in (1, 2):
+        sim = _sim("patrol51", 16, 0.02, 1, nthread=nthread)
+        v = load_vessel("patrol51")
+        st0 = sim.steady_at_order(0, (0.5 * v.telegraph["full"][0],) * sim.ns)
+        for i in range(16):
+            sim.set_state(i, dataclasses.replace(st0, heading=0.4 * i))
+            sim.set_order(i, 0.5 * v.telegraph["full"][0])
+        kin = sim.kinematics()
+        sim.limits[0] = float(np.hypot(kin[:, L.NU_R], kin[:, L.NU_R + 1]).max()) + 0.3
+        sim.set_order(13, 1.2 * v.telegraph["full"][0])
+        counts = []
+        _counting_shards(sim, counts)
+        with pytest.raises(SimulationError) as e:
+            sim.step(100000)
+        out.append((str(e.value), sim._step_count, sim.truth(), [getattr(sim, k).copy() for k in _RUN_ARRAYS],
+                    counts))
+    (m1, c1, t1, a1, n1), (m2, c2, t2, a2, n2) = out
+    assert "(ship 13): speed beyond the runaway limit" in m1 and 0 < c1 < 100000
+    assert n1 == [] and n2 == [4096]  # the threaded run (up to the truth chunk's end) went to the shards
+    assert m1 == m2 and c1 == c2 and np.array_equal(t1, t2)
+    for name, x, y in zip(_RUN_ARRAYS, a1, a2):
+        assert np.array_equal(x, y), name
+
+
+def test_set_state_alone_changes_no_result():
+    """Placing a ship with the evaluation of that ship alone (an environment's reset) gives the
+    simulation of the evaluation of all ships: its own context and governor torques, then every state."""
+    a, b = _sim("patrol51", 3, 0.02), _sim("patrol51", 3, 0.02)
+    for sim in (a, b):
+        sim.step(25)
+    st = a.steady_at_order(0, (0.7 * load_vessel("patrol51").telegraph["full"][0],) * a.ns)
+    b.steady_at_order(0, (0.7 * load_vessel("patrol51").telegraph["full"][0],) * b.ns)
+    st = dataclasses.replace(st, heading=1.0, x=50.0, y=-20.0, time=float(a.time[1]))
+    a.set_state(1, st)
+    b.set_state(1, st, alone=True)
+    assert np.array_equal(a.ctx[1], b.ctx[1]) and np.array_equal(a.mach, b.mach) and a.mach[1, 0, 2] != 0.0
+    for sim in (a, b):
+        sim.step(60)
+    assert np.array_equal(a.truth(), b.truth())
+    for name in _RUN_ARRAYS:
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
 
 
 def test_kinematics_equals_the_evaluated_context():

@@ -277,7 +277,7 @@ class ShipBatch:
                 st["heading"] = float(opts["heading_deg"]) * DEG
                 self.task.psi0[i] = st["heading"]
             s0 = dataclasses.replace(self._steady_state(order), heading=st["heading"], x=st["x"], y=st["y"])
-            self.sim.set_state(i, s0)
+            self.sim.set_state(i, s0, alone=True)
             self.task.begin(i, abs(s0.u), rng_task)
             self.obs_model.reset(i, rng_obs)
             self.steps[i] = 0
@@ -374,7 +374,7 @@ class ShipBatch:
                     failed[i] = True
                     park = dataclasses.replace(self._steady_state("stop"), u=0.0, x=float(self.truth["x"][i]),
                                                y=float(self.truth["y"][i]), time=float(sim.time[i]))
-                    sim.set_state(int(i), park)
+                    sim.set_state(int(i), park, alone=True)
         self.steps += 1
         self._observe(np.arange(self.n))
         reward, term = self.task.score(self.truth, delta)

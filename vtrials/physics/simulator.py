@@ -219,6 +219,8 @@ class Simulator:
         serial, threaded = DY.step_kernels(self.comp_types)
         threads = self.n >= PARALLEL_FROM and nthread > 1
         self._kernel = threaded if threads else serial
+        self._serial = serial
+        self._one_rec = None
         # whole runs of steps in one compiled call (kernel + the batch's step through a hook)
         self._loop = DY.step_loops(self.comp_types)[1 if threads else 0]
         # long runs of many ships: one shard per thread (see _Shard)
@@ -249,8 +251,15 @@ class Simulator:
         self._kin = None
 
     # ------------------------------------------------------------------ state
-    def set_state(self, ship: int, s: ShipState) -> None:
-        """Place ship ``ship`` in condition ``s`` (velocity through the water + current)."""
+    def set_state(self, ship: int, s: ShipState, alone: bool = False) -> None:
+        """Place ship ``ship`` in condition ``s`` (velocity through the water + current).
+
+        The governors' torques come from an evaluation of the forces at the new state: of every ship
+        (their ``ctx``, ``aux``, ... then describe their current states), or with ``alone`` of this
+        ship only (the others keep those of their last step; a step recomputes them all before it
+        uses them, so the simulation is the same either way — what an environment resetting one
+        ship of many needs, at 1/N of the cost).
+        """
         q = self.qpos[ship]
         v = self.qvel[ship]
         q[:] = 0.0
@@ -288,7 +297,10 @@ class Simulator:
         self.ecount[ship] = 0
         self.qfrc[ship] = 0.0
         # governors hold the torque of this state (no start-up transient)
-        self.evaluate()
+        if alone:
+            self._evaluate_ship(ship)
+        else:
+            self.evaluate()
         for k in range(self.ns):
             if self.shaft_mode[ship, k] != GOVERNED:
                 continue
@@ -317,6 +329,19 @@ class Simulator:
         st = self.comp_st.copy()
         self._call(nav=nav, mach=mach, hs=hs, events=ev, ecount=ec, rud_cmd=rc, comp_st=st, krec=-1)
         return self.nudot.copy()
+
+    def _evaluate_ship(self, i: int) -> None:
+        """:meth:`evaluate` of ship ``i`` alone (its rows of ctx, aux, comp_w, nudot, qfrc, status)."""
+        r = slice(i, i + 1)
+        if self._one_rec is None:
+            self._one_rec = np.zeros((1, 1, self.rec_width))
+        self._serial(self.dt, self.qpos[r], self.qvel[r], self.time[r], self.qfrc[r],
+                     self.comp_kind, self.comp_off, self.comp_par[r], self.comp_soff, self.comp_st[r].copy(),
+                     self.minv[r], self.mrb[r], self.ma[r], self.coriolis_mode, self.rb[r], self.steer, self.shaftp,
+                     self.env[r], self.rud_cmd[r].copy(), self.shaft_cmd[r], self.pitch_cmd[r], self.shaft_mode[r],
+                     self.mach[r].copy(), self.nav[r].copy(), self.phases[r], self.hs[r].copy(), self.events[r].copy(),
+                     self.ecount[r].copy(), self.ctx[r], self.aux[r], self.comp_w[r], self.nudot[r], self.limits,
+                     self.status[r], self._one_rec, -1, self.scratch[r])
 
     def kinematics(self) -> np.ndarray:
         """The kinematic part of the context at the current states, (N, NCTX): velocities (over
