@@ -567,15 +567,16 @@ _LOOPS: dict[str, tuple] = {}
 
 
 def step_loops(component_types: list) -> tuple:
-    """(serial, threaded) multi-step loops (:func:`_run_steps`) around :func:`step_kernels`' kernels; they
-    release the GIL (the simulator's shards run the serial one in several Python threads at once)."""
+    """(serial, threaded) multi-step loops (:func:`_run_steps`) around :func:`step_kernels`' kernels; the
+    serial one releases the GIL (the simulator's shards run it in several Python threads at once; the
+    threaded one, whose kernel launches numba's own threads, crashes when compiled so)."""
     serial, threaded = step_kernels(component_types)
     _, tag = registry.dispatcher(list(component_types))
     if tag not in _LOOPS:
         loops = []
-        for kern, name in ((serial, f"_run_steps_{tag}"), (threaded, f"_run_steps_parallel_{tag}")):
+        for kern, name, nogil in ((serial, f"_run_steps_{tag}", True), (threaded, f"_run_steps_parallel_{tag}", False)):
             g = dict(_run_steps.__globals__)
             g["_step_kernel"] = kern
-            loops.append(nb.njit(cache=True, nogil=True)(_twin(_run_steps, name, g)))
+            loops.append(nb.njit(cache=True, nogil=nogil)(_twin(_run_steps, name, g)))
         _LOOPS[tag] = tuple(loops)
     return _LOOPS[tag]
