@@ -221,12 +221,15 @@ def record_names(n_rudders: int, n_shafts: int, comp_names: list[str]) -> list[s
 
 
 def _step_forces(dt, qpos, qvel, time, qfrc,
-                 comp_kind, comp_off, comp_par, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer, shaftp, env,
+                 comp_kind, comp_off, comp_par, par_row, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer,
+                 shaftp, env,
                  rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events, ecount,
                  ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch):
     """Compute MuJoCo's applied generalized forces for every ship; see the module docstring.
 
-    Returns the number of ships whose status is not OK. ``scratch`` is an (N, 64) work array.
+    Returns the number of ships whose status is not OK. ``scratch`` is an (N, 64) work array. Ship i's
+    component parameters are row ``par_row[i]`` of ``comp_par``: ships with equal parameters read one
+    row, which keeps the step's memory traffic small (the values are the same).
     Compiled twice: serially (``prange`` is then ``range``) and with the ships spread over threads;
     each ship's arithmetic is the same either way, so results are bit-identical.
     """
@@ -238,6 +241,7 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
     comp_kind = borrow(comp_kind)
     comp_off = borrow(comp_off)
     comp_par = borrow(comp_par)
+    par_row = borrow(par_row)
     comp_soff = borrow(comp_soff)
     comp_st = borrow(comp_st)
     minv = borrow(minv)
@@ -286,6 +290,7 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
         a = aux[i]
         t = time[i]
         e = env[i]
+        pr = par_row[i]  # the row of comp_par with ship i's parameters (one shared by the ships alike)
         phi, theta, psi, vcn, vce, ac0, ac1, ac2 = kinematics(qpos[i], qvel[i], t, e, steer, shaftp, R, nu1, om,
                                                               nu1r, c)
         psi_u = nav[i, NV_PSI_U] + H.wrap(psi - nav[i, NV_PSI_U])
@@ -311,7 +316,7 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
             tau[j] = 0.0
         for ci in range(C):
             wc = comp_w[i, ci]
-            dispatch(comp_kind[ci], comp_par[i, comp_off[ci]:comp_off[ci + 1]],
+            dispatch(comp_kind[ci], comp_par[pr, comp_off[ci]:comp_off[ci + 1]],
                      comp_st[i, comp_soff[ci]:comp_soff[ci + 1]], e, c, a, wc)
             for j in range(6):
                 tau[j] += wc[j]
@@ -467,7 +472,8 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
 
 def _run_steps(nstep, every, step_count, krow, hook_id, wcount,
                dt, qpos, qvel, time, qfrc,
-               comp_kind, comp_off, comp_par, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer, shaftp, env,
+               comp_kind, comp_off, comp_par, par_row, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer,
+               shaftp, env,
                rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events, ecount,
                ctx, aux, comp_w, nudot, limits, status, rec, scratch):
     """Up to ``nstep`` whole time steps in one call: the step kernel, then MuJoCo's step of the batch
@@ -487,8 +493,8 @@ def _run_steps(nstep, every, step_count, krow, hook_id, wcount,
             krec = krow
             krow += 1
         nbad = _step_kernel(dt, qpos, qvel, time, qfrc,
-                            comp_kind, comp_off, comp_par, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb, steer,
-                            shaftp, env, rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events,
+                            comp_kind, comp_off, comp_par, par_row, comp_soff, comp_st, minv, mrb, ma, coriolis_mode, rb,
+                            steer, shaftp, env, rud_cmd, shaft_cmd, pitch_cmd, shaft_mode, mach, nav, phases, hs, events,
                             ecount, ctx, aux, comp_w, nudot, limits, status, rec, krec, scratch)
         if nbad:
             return done, krow, STOP_STATUS

@@ -172,6 +172,9 @@ class Simulator:
         offs = np.cumsum([0] + [len(c.params) for c in comps])
         self.comp_off = offs.astype(np.int64)
         self.comp_par = np.tile(np.concatenate([np.zeros(0)] + [c.params for c in comps]), (self.n, 1))
+        # the row of comp_par the kernel reads for each ship: the first ship's with the same values
+        # (all of them until set_component_params gives a ship its own)
+        self.par_row = np.zeros(self.n, dtype=np.int64)
         # the components' own states (radiation memory, filters, lags), per ship
         self.comp_soff = np.cumsum([0] + [len(c.states) for c in comps]).astype(np.int64)
         self._comp_st0 = np.concatenate([np.zeros(0)] + [c.states for c in comps])
@@ -336,7 +339,8 @@ class Simulator:
         if self._one_rec is None:
             self._one_rec = np.zeros((1, 1, self.rec_width))
         self._serial(self.dt, self.qpos[r], self.qvel[r], self.time[r], self.qfrc[r],
-                     self.comp_kind, self.comp_off, self.comp_par[r], self.comp_soff, self.comp_st[r].copy(),
+                     self.comp_kind, self.comp_off, self.comp_par, self.par_row[r], self.comp_soff,
+                     self.comp_st[r].copy(),
                      self.minv[r], self.mrb[r], self.ma[r], self.coriolis_mode, self.rb[r], self.steer, self.shaftp,
                      self.env[r], self.rud_cmd[r].copy(), self.shaft_cmd[r], self.pitch_cmd[r], self.shaft_mode[r],
                      self.mach[r].copy(), self.nav[r].copy(), self.phases[r], self.hs[r].copy(), self.events[r].copy(),
@@ -358,7 +362,7 @@ class Simulator:
     def _call(self, nav=None, mach=None, hs=None, events=None, ecount=None, rud_cmd=None, comp_st=None, krec=-1,
               rec=None):
         return self._kernel(self.dt, self.qpos, self.qvel, self.time, self.qfrc,
-                              self.comp_kind, self.comp_off, self.comp_par, self.comp_soff,
+                              self.comp_kind, self.comp_off, self.comp_par, self.par_row, self.comp_soff,
                               self.comp_st if comp_st is None else comp_st, self.minv, self.mrb, self.ma,
                               self.coriolis_mode, self.rb, self.steer, self.shaftp, self.env,
                               self.rud_cmd if rud_cmd is None else rud_cmd, self.shaft_cmd, self.pitch_cmd,
@@ -372,13 +376,19 @@ class Simulator:
 
     def set_component_params(self, ship: int, name: str, params: np.ndarray) -> None:
         """Give ship ``ship`` its own parameter block for component ``name`` (same length as the
-        vessel's; e.g. its own wave realization)."""
+        vessel's; e.g. its own wave realization). The way to change ``comp_par``: the kernel reads each
+        ship's parameters from row ``par_row[ship]``, which this keeps up to date."""
         k = self.comp_names.index(name)
         a, b = int(self.comp_off[k]), int(self.comp_off[k + 1])
         params = np.asarray(params, dtype=np.float64).ravel()
         if params.shape[0] != b - a:
             raise ValueError(f"component {name!r} takes {b - a} parameters, not {params.shape[0]}")
         self.comp_par[ship, a:b] = params
+        # ship reads its own row now; the ships that read its row read the first of them instead
+        shared = np.flatnonzero((self.par_row == ship) & (np.arange(self.n) != ship))
+        if shared.size:
+            self.par_row[shared] = shared[0]
+        self.par_row[ship] = ship
 
     def component_states(self, ship: int, name: str) -> np.ndarray:
         """A view of the internal states of component ``name`` on ship ``ship``."""
@@ -502,7 +512,8 @@ class Simulator:
         return loop(
                 m, every, self._step_count, self._krow, self._hook_id, self._wcount,
                 self.dt, self.qpos, self.qvel, self.time, self.qfrc,
-                self.comp_kind, self.comp_off, self.comp_par, self.comp_soff, self.comp_st, self.minv, self.mrb,
+                self.comp_kind, self.comp_off, self.comp_par, self.par_row, self.comp_soff, self.comp_st, self.minv,
+                self.mrb,
                 self.ma, self.coriolis_mode, self.rb, self.steer, self.shaftp, self.env,
                 self.rud_cmd, self.shaft_cmd, self.pitch_cmd, self.shaft_mode, self.mach, self.nav,
                 self.phases, self.hs, self.events, self.ecount,
@@ -531,7 +542,8 @@ class Simulator:
             srec = sh.no_rec if rec is self._no_rec else sh.rec_rows(rows)
             calls.append((m, every, self._step_count, 0, sh.hook_id, sh.wcount,
                           self.dt, sh.qpos, sh.qvel, sh.time, sh.qfrc,
-                          self.comp_kind, self.comp_off, self.comp_par[a:b], self.comp_soff, self.comp_st[a:b],
+                          self.comp_kind, self.comp_off, self.comp_par, self.par_row[a:b], self.comp_soff,
+                          self.comp_st[a:b],
                           self.minv[a:b], self.mrb[a:b], self.ma[a:b], self.coriolis_mode, self.rb[a:b], self.steer,
                           self.shaftp, self.env[a:b], self.rud_cmd[a:b], self.shaft_cmd[a:b], self.pitch_cmd[a:b],
                           self.shaft_mode[a:b], self.mach[a:b], self.nav[a:b], self.phases[a:b], self.hs[a:b],
