@@ -192,6 +192,9 @@ def kinematics(q, v, t, e, steer, shaftp, R, nu1, om, nu1r, c):
 def kinematics_all(qpos, qvel, time, env, steer, shaftp, ctx, scratch):
     """:func:`kinematics` of every ship into ``ctx`` (N, NCTX), the same values a step kernel or an
     evaluation writes there, without the forces; ``scratch`` (N, ≥ 18)."""
+    # views without reference counting (see borrow), as in the step kernel
+    qpos, qvel, time, env, ctx, scratch = borrow(qpos), borrow(qvel), borrow(time), borrow(env), borrow(ctx), \
+        borrow(scratch)
     for i in range(qpos.shape[0]):
         sc = scratch[i]
         kinematics(qpos[i], qvel[i], time[i], env[i], steer, shaftp, sc[0:9], sc[9:12], sc[12:15], sc[15:18],
