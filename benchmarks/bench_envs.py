@@ -6,16 +6,25 @@ MJCF model (no forces, no environment layer) over the same number of time steps,
 SyncVectorEnv of the scalar env (N copies, each its own one-ship batch). Rates are ship time steps
 per second (physics steps × ships) and environment steps per second (control periods × ships), and
 the simulator alone (Simulator.step of the env's batch, no env layer) to split the cost; the
-ratio to the bare batch is the acceptance figure (target ≥ 50 % at N = 256). Rounds of the three
-are interleaved and medians reported: the machine may be shared (the 1-minute load average before
-and after is written with the results).
+ratio to the bare batch is the acceptance figure (target ≥ 50 % at N = 256). The bare batch has the
+env's thread count (``nthread`` from N = PARALLEL_FROM on, else 1), as the env's simulator has. Rounds
+of the three are interleaved and medians reported: the machine may be shared (the 1-minute load
+average before and after is written with the results).
 
     python benchmarks/bench_envs.py [--ship patrol51] [--task CourseKeeping] [--sea wind_current]
                                     [--nthread 2] [--seconds 1] [--rounds 5] [--sync-max 64]
-                                    [--cpu-time] [--json out.json]
+                                    [--cpu-time] [--critical-path] [--json out.json]
+
+The headline case alone (N = 256, two threads, wall clock; ~20 s once numba's cache is warm):
+
+    python benchmarks/bench_envs.py --nthread 2 --sizes 256
 
 ``--cpu-time`` (with ``--nthread 1``) times by the thread's CPU time instead of the wall clock: on a
-loaded machine the ratios then stay those of the code, not of the scheduler.
+loaded machine the ratios then stay those of the code, not of the scheduler. ``--critical-path``
+(with ``--nthread`` > 1, for N whose runs go to the simulator's shards) estimates the quiet-machine
+ratio on a loaded one from thread CPU times: the env's critical path per step (the main thread's work
+outside its shard plus the slower shard's run) against the one-thread bare batch's CPU time halved
+(the bare batch assumed to scale perfectly: the estimate leans against the env).
 """
 
 from __future__ import annotations
@@ -58,7 +67,9 @@ def bench_size(ship, task, sea, n, nthread, seconds, rounds, sync):
     act = np.zeros((n,) + venv.single_action_space.shape, dtype=np.float32)
     venv.step(act)  # warm-up (kernel compiled or loaded from the cache)
     sub = venv.core.substeps
-    nth = venv.core.sim.batch.nthread if hasattr(venv.core.sim.batch, "nthread") else (nthread if n >= 8 else 1)
+    from vtrials.physics.simulator import PARALLEL_FROM
+    nth = nthread if n >= PARALLEL_FROM else 1  # the env's own rule
+    assert venv.core.sim.batch.nthread == nth
     bare = mjbatch.Batch(venv.core.sim.model, n, nthread=nth)
     sim = venv.core.sim
 
@@ -87,6 +98,49 @@ def bench_size(ship, task, sea, n, nthread, seconds, rounds, sync):
             "sync_env_steps_per_s": med(rs), "vector_over_sync": med(rv) / med(rs) if rs else float("nan")}
 
 
+def critical_path(ship, task, sea, n, nthread, rounds, calls=20):
+    """Thread-CPU estimate of the quiet-machine vector/bare ratio (see the module docstring)."""
+    import threading
+    from mujoco import batch as mjbatch
+    from vtrials.envs.vector import ShipVectorEnv
+    venv = ShipVectorEnv(n, task, ship, sea=sea, nthread=nthread)
+    venv.reset(seed=0)
+    act = np.zeros((n,) + venv.single_action_space.shape, dtype=np.float32)
+    venv.step(act)
+    sim, sub = venv.core.sim, venv.core.substeps
+    if not sim._shards or n * sub < __import__("vtrials.physics.simulator", fromlist=["SHARD_FROM"]).SHARD_FROM:
+        return None
+    loop, main_id, runs = sim._loop_serial, threading.get_ident(), []
+
+    def timed(*args):
+        t0 = time.thread_time()
+        out = loop(*args)
+        runs.append((threading.get_ident() == main_id, time.thread_time() - t0))
+        return out
+
+    sim._loop_serial = timed
+    bare1 = mjbatch.Batch(sim.model, n, nthread=1)
+    per = 1e9 / (calls * n * sub)
+    b, c = [], []
+    for _ in range(rounds):
+        t0 = time.thread_time()
+        for _ in range(calls * sub):
+            bare1.step()
+        b.append((time.thread_time() - t0) * per)
+        runs.clear()
+        t0 = time.thread_time()
+        for _ in range(calls):
+            venv.step(act)
+        main = time.thread_time() - t0
+        k = len(sim._shards)
+        shard = np.array([t for _, t in runs]).reshape(-1, k)  # one row per run
+        own = sum(t for m, t in runs if m)
+        c.append((main - own + shard.max(axis=1).sum()) * per)
+    bare_cpu, crit = float(np.median(b)), float(np.median(c))
+    return {"bare_batch_one_thread_cpu_ns_per_ship_step": bare_cpu, "vector_critical_path_cpu_ns_per_ship_step": crit,
+            "estimated_quiet_vector_over_bare": bare_cpu / nthread / crit}
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ship", default="patrol51")
@@ -99,6 +153,8 @@ def main(argv=None):
     ap.add_argument("--sync-max", type=int, default=64, help="largest N run through SyncVectorEnv")
     ap.add_argument("--cpu-time", action="store_true",
                     help="rates by the thread's CPU time, robust on a loaded machine (needs --nthread 1)")
+    ap.add_argument("--critical-path", action="store_true",
+                    help="also the thread-CPU estimate of the quiet-machine ratio (nthread > 1, sharded sizes)")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
     if a.cpu_time:
@@ -118,6 +174,13 @@ def main(argv=None):
               f"{row['bare_batch_ship_steps_per_s']:>12.0f} {row['vector_over_bare']:>9.2f} "
               f"{row['simulator_over_bare']:>9.2f} {row['vector_over_simulator']:>8.2f} "
               f"{row['sync_env_steps_per_s']:>17.0f} {row['vector_over_sync']:>9.2f}", flush=True)
+        if a.critical_path and a.nthread > 1:
+            cp = critical_path(a.ship, a.task, a.sea, n, a.nthread, a.rounds)
+            if cp is not None:
+                row.update(cp)
+                print(f"      critical path {cp['vector_critical_path_cpu_ns_per_ship_step']:.0f} ns/ship-step (thread CPU), "
+                      f"bare one thread {cp['bare_batch_one_thread_cpu_ns_per_ship_step']:.0f}: estimated quiet "
+                      f"vec/bare {cp['estimated_quiet_vector_over_bare']:.2f}", flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps({"ship": a.ship, "task": a.task, "sea": a.sea, "nthread": a.nthread,
                                             "clock": "thread CPU time" if a.cpu_time else "wall",
