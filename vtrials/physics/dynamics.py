@@ -302,7 +302,9 @@ def _step_forces(dt, qpos, qvel, time, qfrc,
         c[C_WIND_GUST] = gust_step(e, nav[i, NV_GUST:], t, dt)
         # --- helm: one order for all rudders
         if nr > 0:
-            order = H.helm_step(i, t, psi_u, om[2], dt, phases, hs, events, ecount, rud_cmd[i, 0])
+            order = rud_cmd[i, 0]
+            if hs[i, H.H_ACTIVE] != 0.0:  # (helm_step returns the order as it is when off; the call costs)
+                order = H.helm_step(i, t, psi_u, om[2], dt, phases, hs, events, ecount, order)
             for k in range(nr):
                 rud_cmd[i, k] = order
         # --- machinery before the forces: pitch actuators, set-point ramps, engine torque
