@@ -117,6 +117,24 @@ def test_vector_env_ship_i_is_the_scalar_env_with_seed_plus_i():
         assert np.array_equal(vr[:, i], sr)
 
 
+def test_vector_env_on_two_threads_is_the_one_thread_env():
+    """16 ships on two threads (runs on the simulator's shards, a partial reset on the way)
+    give the observations, rewards and ends of the one-thread env, bit for bit."""
+    n, out = 16, []
+    for nthread in (1, 2):
+        venv = ShipVectorEnv(n, "ZigZag", "patrol51", sea="wind_current", nthread=nthread)
+        assert bool(venv.core.sim._shards) == (nthread == 2)
+        rng = np.random.default_rng(3)
+        rec = [venv.reset(seed=11)[0]]
+        for k in range(40):
+            obs, r, term, trunc, _ = venv.step(rng.uniform(-1, 1, (n, 1)).astype(np.float32))
+            rec += [obs, r, term, trunc]
+            if k == 15:
+                rec.append(venv.reset(options={"reset_mask": np.arange(n) % 3 == 0})[0])
+        out.append(np.concatenate([np.asarray(x, dtype=np.float64).ravel() for x in rec]))
+    assert np.array_equal(out[0], out[1])
+
+
 def test_vector_autoreset_next_step():
     """Gymnasium 1.x NEXT_STEP: the step after the end returns the reset observation, reward 0."""
     venv = ShipVectorEnv(2, "Stopping", "patrol51", sea="calm")
