@@ -73,25 +73,45 @@ def test_two_run_spots_take_a_common_offset_and_the_trend():
     assert np.max(np.abs(np.array(two_run) - truth)) > 0.005  # what the trend correction removes
 
 
-def test_intervals_cover_95_percent_of_noisy_days():
-    """Gaussian speed-over-ground errors twice the stated σ (the stated σ too small, as a single run's
-    fix statistics are): the Birge-scaled Student-t intervals still cover ~95 %."""
-    t, hd, grp, vg0, truth = _day()
-    rng = np.random.default_rng(11)
+def _noisy_days(ship_sd, n_days=400, seed=11):
+    """Monte Carlo of the day of :func:`_day`: tracking errors at their stated σ, and the ship's own
+    speed scattering run to run by ship_sd (the spot's truth is the heading-balanced mean of ITS runs'
+    speeds, as scored). Coverage, sharpness, the fitted scatter τ and the errors' RMS."""
+    t, hd, grp, vg0, _ = _day()
+    s = np.sign(np.cos(hd - hd[0]))
+    g = np.array(grp)
+    rng = np.random.default_rng(seed)
     stated = rng.uniform(0.004, 0.012, vg0.size)
-    cov, hw, err = [], [], []
-    for _ in range(400):
-        vg = vg0 + rng.normal(0.0, 2.0 * stated)
+    cov, hw, err, taus = [], [], [], []
+    for _ in range(n_days):
+        delta = rng.normal(0.0, ship_sd, vg0.size)
+        vg = vg0 + delta + rng.normal(0.0, stated)
         f = CUR.joint_spot_current_fit(t, vg, stated, hd, grp)
-        for e, tr in zip(f.vs, truth):
+        taus.append(f.ship_scatter)
+        for k, e in zip(f.groups, f.vs):
+            m = g == k
+            # the truth of the day of _day is balanced already; the runs' own scatter moves it
+            tr = _day()[4][k - 1] + 0.5 * (delta[m & (s > 0)].mean() + delta[m & (s < 0)].mean())
             lo, hi = e.interval()
             cov.append(lo <= tr <= hi)
             hw.append(0.5 * (hi - lo))
             err.append(abs(e.value - tr))
-    c = np.mean(cov)
+    return np.mean(cov), np.mean(hw) / np.quantile(err, 0.95), np.mean(taus), np.sqrt(np.mean(np.square(err)))
+
+
+@pytest.mark.parametrize("ship_sd", [0.0, 0.02])
+def test_intervals_cover_95_percent_of_noisy_days(ship_sd):
+    """Tracking errors at their stated σ, with and without a run-to-run scatter of the ship's own speed
+    (0.02 m/s: gusts, a spot not quite settled — KVLCC2's spots scatter so): the intervals cover ~95 %
+    and are not wider than the errors need. The ship's scatter is found (Paule–Mandel) and counts only
+    where the fit weighs a spot's runs otherwise than the spot's own balanced mean: the errors stay
+    near the tracking's, far below the 0.02 m/s a Birge-scaled budget would state."""
+    c, sharp, tau, rms = _noisy_days(ship_sd)
     assert 0.93 <= c <= 0.975, c
-    sharp = np.mean(hw) / np.quantile(err, 0.95)
     assert 0.9 <= sharp <= 1.5, sharp
+    if ship_sd:
+        assert tau == pytest.approx(ship_sd, rel=0.25), tau
+        assert rms < 0.5 * ship_sd, rms
 
 
 def test_bad_runs_are_clear_errors():

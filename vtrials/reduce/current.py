@@ -151,6 +151,7 @@ class SpotCurrentFit:
     scale: float
     residuals: np.ndarray
     cov_stated: np.ndarray
+    ship_scatter: float = 0.0
 
     def current_change(self, t) -> np.ndarray:
         """The fitted time-varying part of the along-course current at times t [s] (m/s; its constant
@@ -200,9 +201,15 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
 
     Inputs: t [s] run mid-times, vg [m/s] speeds over ground, vg_std [m/s] their stated standard
     uncertainty (tracking), heading [rad] (base course or its reciprocal), group the spot of each run.
-    Uncertainty (GUM, JCGM 100:2008 §4.2 and ITTC 7.5-02-01-01 for a least-squares fit): the stated
-    σ propagated through the fit, scaled by the Birge ratio √max(1, χ²/dof) when the runs scatter more
-    than the stated σ allow (Student t on the fit's dof then; normal otherwise).
+    Uncertainty (GUM, JCGM 100:2008; ITTC 7.5-02-01-01 for a least-squares fit): when the runs
+    scatter more than the stated σ allow, the excess is taken as run-to-run scatter τ of the ship's own
+    speed (gusts, helm, a big ship not quite settled; Paule–Mandel: χ² = dof) and the runs are weighed
+    by σᵢ² + τ². With V̂_g = Σ aᵢ V_G,i, the error against the spot's heading-balanced mean of its runs'
+    speeds (w̃) is Σ aᵢ eᵢ + Σ (aᵢ − w̃ᵢ) δᵢ: the tracking σ propagated, plus τ² Σ (aᵢ − w̃ᵢ)² — where
+    the fit weighs a spot's runs as that mean does, the ship's scatter is the reference's too and does
+    not count. Student t on the Welch–Satterthwaite dof (the τ part on the fit's dof); normal when the
+    runs scatter no more than stated. The stated σ must then be honest: the tracking fix statistics
+    with the data sheet's time-correlated error (:func:`vtrials.reduce.runstats.sog_from_track`).
     """
     t, vg, vg_std, heading = (np.asarray(a, dtype=float) for a in (t, vg, vg_std, heading))
     n = vg.size
@@ -259,16 +266,49 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
         both = [None]
     chosen = chosen[0]
     p = X.shape[1]
-    Xw = X * w[:, None]
-    beta, *_ = np.linalg.lstsq(Xw, vg * w, rcond=None)
-    r = vg - X @ beta
-    chi2 = float(np.sum((r * w) ** 2))
     dof = n - p
+
+    def solve(tau):
+        wt = 1.0 / np.sqrt(vg_std ** 2 + tau ** 2)
+        Xw = X * wt[:, None]
+        beta, *_ = np.linalg.lstsq(Xw, vg * wt, rcond=None)
+        r = vg - X @ beta
+        return wt, Xw, beta, r, float(np.sum((r * wt) ** 2))
+
+    w, Xw, beta, r, chi2 = solve(0.0)
     cov = np.linalg.pinv(Xw.T @ Xw)
     scale = max(1.0, chi2 / dof) if dof > 0 else 1.0
-    est_dof = dof if (dof > 0 and scale > 1.0) else None
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0) * scale)
-    vs = tuple(Estimate(float(beta[k]), float(sd[k]), est_dof) for k in range(G))
+    # run-to-run scatter of the ship's own speed (gusts, helm, a spot not quite settled) beyond the
+    # tracking's stated σ: one variance τ² common to the runs, such that χ² = dof (Paule & Mandel
+    # 1982, J. Res. NBS 87(5), the consensus-mean estimator; DerSimonian–Laird's idea for a fit)
+    tau = 0.0
+    if dof > 0 and chi2 > dof:
+        hi = float(np.max(np.abs(r))) + float(np.max(vg_std))
+        while solve(hi)[4] > dof:
+            hi *= 2.0
+        tau = optimize.brentq(lambda x: solve(x)[4] - dof, 0.0, hi, xtol=1e-9)
+        w, Xw, beta, r, _ = solve(tau)
+    A = np.linalg.pinv(Xw) * w[None, :]  # β̂ = A v_G
+    vs = []
+    for k in range(G):
+        # the spot's reference is its heading-balanced mean of the runs' own speeds (what the fit's V_g
+        # means: vtrials.score.trials.spot_stw_truth), so a run's speed scatter enters the error only
+        # through (a − w̃): where the fit weighs the runs as that mean does it cancels
+        m = gi == k
+        wt_ref = np.zeros(n)
+        for c in (-1.0, 1.0):
+            mc = m & (s == c)
+            if mc.any():
+                wt_ref[mc] = 1.0 / mc.sum()
+        wt_ref /= wt_ref.sum()
+        a = A[k]
+        u_track = float(np.sum((a * vg_std) ** 2))
+        u_ship = tau ** 2 * float(np.sum((a - wt_ref) ** 2))
+        u2 = u_track + u_ship
+        # Welch–Satterthwaite: the ship's scatter part is estimated on the fit's dof
+        nu = u2 ** 2 / (u_ship ** 2 / dof) if u_ship > 0 else None
+        vs.append(Estimate(float(beta[k]), math.sqrt(u2), nu))
+    vs = tuple(vs)
     off = [math.nan] * G
     for j, k in enumerate(both):
         if k is None:  # one offset for the day
@@ -277,7 +317,7 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
             off[k] = float(beta[G + j])
     return SpotCurrentFit(groups=groups, vs=vs, offset=tuple(off), model=chosen, shape=beta[G + len(both):],
                           t_ref=t_ref, t_span=t_span, period=float(period), chi2=chi2, dof=dof, scale=scale,
-                          residuals=r, cov_stated=cov)
+                          residuals=r, cov_stated=cov, ship_scatter=float(tau))
 
 
 @dataclasses.dataclass(frozen=True)

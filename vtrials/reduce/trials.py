@@ -66,6 +66,37 @@ def _angular(kind: str, channel: str) -> bool:
     return channel in ("heading", "cog") or (kind == "anemometer" and channel == "angle")
 
 
+def _fix_errors(meta: dict, north, east) -> list:
+    """The tracking system's fix errors as its data sheet gives them, in the form
+    :func:`vtrials.reduce.runstats.sog_from_track` takes: (G, sd, τ) per error source.
+
+    Range–range radar: each transponder's range error (multipath, white) maps into the fix through
+    the two range lines, δp = M⁻¹ δr with M's rows the unit vectors from the surveyed stations to the
+    fix (the geometric dilution the fix suffers where the lines cross at a narrow angle). GNSS: the
+    stated correlated parts per axis, and the rest of the stated horizontal accuracy as white."""
+    north, east = np.asarray(north, float), np.asarray(east, float)
+    kind = meta.get("kind")
+    if kind == "range_radar" and meta.get("range_errors"):
+        p = np.column_stack([north, east])
+        ua = p - np.asarray(meta["transponder_a"], float)
+        ub = p - np.asarray(meta["transponder_b"], float)
+        ua /= np.linalg.norm(ua, axis=1)[:, None]
+        ub /= np.linalg.norm(ub, axis=1)[:, None]
+        det = ua[:, 0] * ub[:, 1] - ua[:, 1] * ub[:, 0]
+        if np.any(np.abs(det) < 1e-6):
+            return []  # on the baseline: the fix has no geometry (the residuals' statistics only)
+        # M = [ua; ub] (2×2 per sample): columns of M⁻¹ = the fix's response to each range's error
+        g_a = np.column_stack([ub[:, 1], -ub[:, 0]]) / det[:, None]
+        g_b = np.column_stack([-ua[:, 1], ua[:, 0]]) / det[:, None]
+        return [(g, sd, tau) for sd, tau in meta["range_errors"] for g in (g_a, g_b)]
+    if kind == "gnss" and meta.get("horizontal_accuracy_m"):
+        corr = [tuple(map(float, x)) for x in meta.get("correlated_errors", [])]
+        white = math.sqrt(max(float(meta["horizontal_accuracy_m"]) ** 2 - sum(sd * sd for sd, _ in corr), 0.0))
+        axes = (np.tile([1.0, 0.0], (north.size, 1)), np.tile([0.0, 1.0], (north.size, 1)))
+        return [(g, sd, tau) for sd, tau in corr + [(white, 0.0)] if sd > 0 for g in axes]
+    return []
+
+
 def accepted_runs(rec: Record) -> list[dict]:
     """The log sheet's accepted runs, in run order (one entry per run number)."""
     return sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
@@ -99,7 +130,8 @@ def run_statistics(rec: Record, run: dict) -> dict:
             _, e = rec.channel(name, "east")
             ok = np.isfinite(n) & np.isfinite(e)
             try:
-                fit = RS.sog_from_track(t[ok], n[ok], e[ok], t0, t1)
+                fit = RS.sog_from_track(t[ok], n[ok], e[ok], t0, t1,
+                                        fix_errors=_fix_errors(rec.meta(name), n[ok], e[ok]))
                 out["sog"][name] = {"sog": _est(fit.sog), "cog": _est(fit.cog), "kind": kind,
                                     "along_rms": fit.along_rms, "cross_rms": fit.cross_rms, "n": fit.n}
             except ValueError:
