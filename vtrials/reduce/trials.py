@@ -298,9 +298,42 @@ def _along_course(run: dict) -> Estimate:
     return Estimate(v * c, math.hypot(c * sv, v * math.sin(d) * sd), run["vg"].dof)
 
 
+OFF_COURSE = math.radians(20.0)  # a run's track this far from its ordered course is not on the measured course
+
+
+def _runs_on_the_course(rec: Record, runs: list[dict]) -> tuple[list[dict], list[dict]]:
+    """The runs the speed analysis may use, and those it sets aside with the reason.
+
+    ITTC 7.5-04-01-01.1 (2017) §5: runs that do not meet the steadiness criteria are rejected. A run
+    the director flagged unsteady (the log sheet: the approach never settled and the run went ahead)
+    is set aside when its spot keeps a run on each course without it; and a run whose track is more
+    than 20° off its ordered course (a slow ship that could not hold its heading in a strong beam
+    wind) is not on the measured course at all, whatever the log sheet says."""
+    log = {r["run"]: r for r in accepted_runs(rec)}
+    out, bad = [], []
+    for r in runs:
+        s = r["sog"][r["tracking"]]
+        off = abs(RS.wrap_pi(s["cog"]["value"] - r["course"])) if "cog" in s else 0.0
+        if off > OFF_COURSE:
+            bad.append({"run": r["run"], "reason": f"track {math.degrees(off):.0f}° off the ordered course"})
+        else:
+            out.append(r)
+    keep = []
+    for r in out:
+        if not r["steady"]:
+            others = [x for x in out if x["group"] == r["group"] and x is not r and x["steady"]]
+            sides = {math.copysign(1.0, math.cos(x["course"] - r["course"])) for x in others}
+            if sides == {1.0, -1.0}:
+                notes = "; ".join(log[r["run"]]["approach_notes"] + log[r["run"]]["run_notes"])
+                bad.append({"run": r["run"], "reason": f"flagged unsteady ({notes})"})
+                continue
+        keep.append(r)
+    return keep, bad
+
+
 def reduce_standardization(rec: Record) -> dict:
     team = rec.team
-    runs = [run_statistics(rec, r) for r in accepted_runs(rec)]
+    runs, excluded = _runs_on_the_course(rec, [run_statistics(rec, r) for r in accepted_runs(rec)])
     if not runs:
         raise ValueError(f"{rec.path}: no accepted runs")
     groups = sorted({r["group"] for r in runs})
@@ -428,7 +461,7 @@ def reduce_standardization(rec: Record) -> dict:
         d["power"] = None if pw is None else _est(Estimate(pw.value, math.hypot(pw.std, r.get("power_calibration_std", 0.0))))
         runs_out.append(d)
     out = {"kind": "standardization", "tracking": runs[0]["tracking"], "runs": runs_out, "spots": spots,
-           "curve": curve,
+           "curve": curve, "excluded_runs": excluded,
            "joint_fit": {"current_model": joint.model, "dof": joint.dof, "chi2": joint.chi2,
                          "birge_ratio": math.sqrt(joint.scale), "offsets": list(joint.offset),
                          "current_change": [float(x) for x in joint.current_change(tt)],
