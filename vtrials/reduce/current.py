@@ -124,6 +124,34 @@ def ittc_mean_of_means(vg, std=None) -> Estimate:
 # ==================================================================================================
 # joint fit of a standardization day: one speed per spot, one current for the day
 # ==================================================================================================
+def ship_scatter(solve, chi2: float, dof: int, resid, std):
+    """Run-to-run scatter τ of the ship's own speed (gusts, helm, a spot not quite settled) beyond the
+    tracking's stated σ, for a fit of speeds over ground: the one variance τ² common to the runs for
+    which χ² = dof when the runs are weighed by 1/(σᵢ² + τ²) (Paule & Mandel 1982, J. Res. NBS 87(5),
+    the consensus-mean estimator, applied to a fit). ``solve(τ)`` refits with those weights and returns
+    (w, weighted Jacobian, β, residuals, χ²); ``chi2`` is its χ² at τ = 0. Returns (τ, solve(τ))."""
+    if not (dof > 0 and chi2 > dof):
+        return 0.0, solve(0.0)
+    hi = float(np.max(np.abs(resid))) + float(np.max(std))
+    while solve(hi)[4] > dof:
+        hi *= 2.0
+    tau = optimize.brentq(lambda x: solve(x)[4] - dof, 0.0, hi, xtol=1e-9)
+    return float(tau), solve(tau)
+
+
+def scatter_budget(a, std, tau: float, ref, dof: int) -> tuple[float, float | None]:
+    """Standard uncertainty and dof of an estimate Σ aᵢ V_i of speeds V_i = Vᵢ* + eᵢ + δᵢ (eᵢ the tracking
+    error, σᵢ; δᵢ the ship's own scatter, τ) against the reference Σ w̃ᵢ Vᵢ* + δᵢ — the mean of the
+    same runs' true speeds, which carries their scatter too: u² = Σ aᵢ² σᵢ² + τ² Σ (aᵢ − w̃ᵢ)²; where the
+    fit weighs the runs as the reference does, the scatter cancels. Welch–Satterthwaite dof with the
+    τ part on the fit's dof (None: normal)."""
+    u_track = float(np.sum((np.asarray(a) * std) ** 2))
+    u_ship = tau ** 2 * float(np.sum((np.asarray(a) - ref) ** 2))
+    u2 = u_track + u_ship
+    nu = u2 ** 2 / (u_ship ** 2 / dof) if u_ship > 0 else None
+    return math.sqrt(u2), nu
+
+
 @dataclasses.dataclass(frozen=True)
 class SpotCurrentFit:
     """Result of :func:`joint_spot_current_fit`.
@@ -278,36 +306,19 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
     w, Xw, beta, r, chi2 = solve(0.0)
     cov = np.linalg.pinv(Xw.T @ Xw)
     scale = max(1.0, chi2 / dof) if dof > 0 else 1.0
-    # run-to-run scatter of the ship's own speed (gusts, helm, a spot not quite settled) beyond the
-    # tracking's stated σ: one variance τ² common to the runs, such that χ² = dof (Paule & Mandel
-    # 1982, J. Res. NBS 87(5), the consensus-mean estimator; DerSimonian–Laird's idea for a fit)
-    tau = 0.0
-    if dof > 0 and chi2 > dof:
-        hi = float(np.max(np.abs(r))) + float(np.max(vg_std))
-        while solve(hi)[4] > dof:
-            hi *= 2.0
-        tau = optimize.brentq(lambda x: solve(x)[4] - dof, 0.0, hi, xtol=1e-9)
-        w, Xw, beta, r, _ = solve(tau)
+    tau, (w, Xw, beta, r, _) = ship_scatter(solve, chi2, dof, r, vg_std)
     A = np.linalg.pinv(Xw) * w[None, :]  # β̂ = A v_G
     vs = []
     for k in range(G):
         # the spot's reference is its heading-balanced mean of the runs' own speeds (what the fit's V_g
-        # means: vtrials.score.trials.spot_stw_truth), so a run's speed scatter enters the error only
-        # through (a − w̃): where the fit weighs the runs as that mean does it cancels
+        # means: vtrials.score.trials.spot_stw_truth)
         m = gi == k
         wt_ref = np.zeros(n)
         for c in (-1.0, 1.0):
             mc = m & (s == c)
             if mc.any():
                 wt_ref[mc] = 1.0 / mc.sum()
-        wt_ref /= wt_ref.sum()
-        a = A[k]
-        u_track = float(np.sum((a * vg_std) ** 2))
-        u_ship = tau ** 2 * float(np.sum((a - wt_ref) ** 2))
-        u2 = u_track + u_ship
-        # Welch–Satterthwaite: the ship's scatter part is estimated on the fit's dof
-        nu = u2 ** 2 / (u_ship ** 2 / dof) if u_ship > 0 else None
-        vs.append(Estimate(float(beta[k]), math.sqrt(u2), nu))
+        vs.append(Estimate(float(beta[k]), *scatter_budget(A[k], vg_std, tau, wt_ref / wt_ref.sum(), dof)))
     vs = tuple(vs)
     off = [math.nan] * G
     for j, k in enumerate(both):

@@ -529,8 +529,14 @@ def curve_power(curve: dict, v) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------- log calibration
-def _joint_current_fit(t, heading, vg, group, trend: bool):
-    """|U_g h_i + c(t_i)| least squares: parameters U per group, c_N, c_E (and their rates)."""
+def _joint_current_fit(t, heading, vg, vg_std, group, trend: bool):
+    """|U_g h_i + c(t_i)| least squares: parameters U per group, c_N, c_E (and their rates).
+
+    Legs weighed by 1/(σᵢ² + τ²), τ the ship's own leg-to-leg speed scatter beyond the tracking's stated
+    σ (:func:`vtrials.reduce.current.ship_scatter`). The groups' speeds carry the tracking σ through
+    the (linearised) fit and τ only through their difference from the group's plain mean of its legs
+    — the reference, whose legs scatter alike (:func:`vtrials.reduce.current.scatter_budget`); the
+    current's covariance is the weighted fit's, scaled to χ²/dof = 1."""
     groups = sorted(set(group))
     gi = np.array([groups.index(g) for g in group])
     G = len(groups)
@@ -544,13 +550,25 @@ def _joint_current_fit(t, heading, vg, group, trend: bool):
         return np.hypot(U * hc + cn, U * hs + ce)
 
     x0 = np.concatenate([[np.mean(vg[gi == k]) for k in range(G)], [0.0, 0.0], [0.0, 0.0] if trend else []])
-    res = optimize.least_squares(lambda x: model(x) - vg, x0, method="lm", xtol=1e-14, ftol=1e-14)
-    J = res.jac
     n, p = vg.size, x0.size
     dof = n - p
-    s2 = float(res.fun @ res.fun) / dof if dof > 0 else math.nan
+
+    def solve(tau):
+        w = 1.0 / np.sqrt(vg_std ** 2 + tau ** 2)
+        res = optimize.least_squares(lambda x: (model(x) - vg) * w, x0, method="lm", xtol=1e-14, ftol=1e-14)
+        return w, res.jac, res.x, res.fun / w, float(res.fun @ res.fun)
+
+    fit0 = solve(0.0)
+    tau, (w, J, x, r, chi2) = CUR.ship_scatter(solve, fit0[4], dof, fit0[3], vg_std)
+    s2 = chi2 / dof if dof > 0 else math.nan
     cov = np.linalg.pinv(J.T @ J) * s2
-    return groups, res.x, cov, dof, tm, res.fun
+    A = np.linalg.pinv(J) * w[None, :]
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    Ug = []
+    for k in range(G):
+        ref = (gi == k) / float(np.count_nonzero(gi == k))
+        Ug.append(CUR.scatter_budget(A[k], vg_std, tau, ref, dof))
+    return groups, x, cov, sd, Ug, dof, tm, r, tau
 
 
 def reduce_log_calibration(rec: Record) -> dict:
@@ -683,15 +701,14 @@ def resolve_current(t, heading, vg, vg_std, group):
     p = G + (4 if trend else 2)
     rank = int(np.linalg.matrix_rank(design(trend)))
     if n > p and rank == p:
-        groups, x, cov, dof, tm, resid = _joint_current_fit(t, heading, vg, group, trend)
-        sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-        U = {g: Estimate(float(x[k]), float(sd[k]), dof) for k, g in enumerate(groups)}
+        groups, x, cov, sd, Ug, dof, tm, resid, tau = _joint_current_fit(t, heading, vg, vg_std, group, trend)
+        U = {g: Estimate(float(x[k]), *Ug[k]) for k, g in enumerate(groups)}
         cur = {"north": Estimate(float(x[G]), float(sd[G]), dof),
                "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof), "trend": trend, "t_ref": tm}
         if trend:
             cur["north_rate"] = Estimate(float(x[G + 2]), float(sd[G + 2]), dof)
             cur["east_rate"] = Estimate(float(x[G + 3]), float(sd[G + 3]), dof)
-        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend}, []
+        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend, "ship_scatter": tau}, []
     if rank < p:
         axes = sorted({round(math.degrees(h) % 180.0, 1) for h in heading})
         why = (f"the legs lie on {'one axis' if len(axes) == 1 else 'too few axes'} "
