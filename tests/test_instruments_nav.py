@@ -377,3 +377,26 @@ def test_logger_clock_input_errors():
         _iset([{"name": "dgps", "spec": "dgps", "site": "gnss_antenna", "clock": "gps_time"}])
     with pytest.raises(InputError, match=r"instrument\[0\]\.clock.*'gyrocompass' is not a clock"):
         _iset([{"name": "dgps", "spec": "dgps", "site": "gnss_antenna", "clock": "gyrocompass"}])
+
+
+def test_range_radar_fix_error_geometry_is_the_fixs_own_response():
+    """The reduction's data-sheet model of the radar's fix error (vtrials.reduce.trials._fix_errors)
+    maps a range error into the fix as the fix computation itself does: against finite differences of
+    two_range_fix at points of wide and narrow crossing angle."""
+    from vtrials.instruments.devices import two_range_fix
+    from vtrials.reduce.trials import _fix_errors
+    a, b = np.array([-12000.0, -9000.0]), np.array([-12000.0, 9000.0])
+    meta = {"kind": "range_radar", "transponder_a": a.tolist(), "transponder_b": b.tolist(),
+            "range_errors": [[2.0, 30.0], [1.8, 0.0]]}
+    p = np.array([[0.0, 0.0], [-11000.0, 200.0], [3000.0, -4000.0]])
+    errs = _fix_errors(meta, p[:, 0], p[:, 1])
+    assert [(sd, tau) for _, sd, tau in errs] == [(2.0, 30.0), (2.0, 30.0), (1.8, 0.0), (1.8, 0.0)]
+    ra, rb = np.linalg.norm(p - a, axis=1), np.linalg.norm(p - b, axis=1)
+    h = 0.01
+    for G, dra, drb in ((errs[0][0], h, 0.0), (errs[1][0], 0.0, h)):
+        n1, e1 = two_range_fix(ra + dra, rb + drb, a, b, -1.0)  # north of a→b: port
+        n0, e0 = two_range_fix(ra - dra, rb - drb, a, b, -1.0)
+        fd = np.column_stack([n1 - n0, e1 - e0]) / (2 * h)
+        np.testing.assert_allclose(G, fd, rtol=1e-5, atol=1e-7)
+    # near the baseline the fix's dilution is large (and the model says so)
+    assert np.linalg.norm(errs[0][0][1]) > 4.0 * np.linalg.norm(errs[0][0][0])  # 4.4x at 1 km off it

@@ -143,7 +143,7 @@ def test_stawave_corrected_reduction_recovers_the_calm_water_curve(sea_day):
         w = np.linspace(0.2, 6.0, 600) * (2.0 * math.pi / sea[0]["tp_s"])
         head = stawave2(w, observed_spectrum(w, sea[0]["hs_m"], sea[0]["tp_s"], sea[0]["gamma"]), V, p.length,
                         p.beam, p.draught, C_B, rho=p.water_density)
-        # (the reported spot speed is refined after the corrections by the two-run trend step: 0.1 % here)
+        # (the spot speed is the joint fit's: the pairs' average corrected by the trend between the spots)
         assert sorted(x["r_aw"] for x in s["waves"]) == pytest.approx([0.5 * head, head], rel=5e-3)
         Pt = float(P_true(V))
         cal = calibration_power_error(meters, s["torque"], s["rps"])

@@ -1,8 +1,10 @@
 """Monte Carlo campaigns: many replicates of one trial agenda, every reduced quantity scored.
 
 A replicate is the whole chain — draw the varied scenario fields and a fresh scenario seed, let the
-crew run the agenda, write the records, reduce them, score against truth — in a worker process. It
-returns one row per reduced quantity that carries an interval:
+crew run the agenda, reduce its records, score against truth — in a worker process. The records are
+reduced in memory (:func:`vtrials.runner.trial_day.score_agenda`: the same arrays the record files would
+hold, the same reduction code); truth.nc, the records and results.json are written only when the
+campaign keeps them (``keep_records``). It returns one row per reduced quantity that carries an interval:
 
     replicate, quantity, group, reduced, std, lo95, hi95, half_width95, truth, error, covered
 
@@ -86,7 +88,7 @@ def rows_of(results: dict, replicate: int) -> list[dict]:
 
 def run_replicate(path: str, index: int, campaign_seed: int, n_total: int, keep_dir: str | None = None) -> dict:
     """Run replicate ``index`` of the campaign in ``path`` (in a worker); returns its rows and draws."""
-    from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
+    from vtrials.runner.trial_day import score_agenda, simulate_agenda, write_agenda_outputs
     from vtrials.scenario import load_scenario
     spec = load_campaign(path)
     ss = replicate_seeds(campaign_seed, n_total)[index]
@@ -95,15 +97,18 @@ def run_replicate(path: str, index: int, campaign_seed: int, n_total: int, keep_
     if scn.agenda is None:
         raise InputError(path, "agenda", "a campaign needs an [agenda] (its reductions are what is scored)")
     res = simulate_agenda(scn)
-    with tempfile.TemporaryDirectory(prefix="vtrials-rep-") as tmp:
-        out = write_agenda_outputs(res, tmp, plot=False)
-        if keep_dir is not None:
+    if keep_dir is None:
+        # the fast path: records reduced in memory (the same arrays the files would hold), nothing written
+        out = score_agenda(res)
+    else:
+        with tempfile.TemporaryDirectory(prefix="vtrials-rep-") as tmp:
+            out = write_agenda_outputs(res, tmp, plot=False)
             dest = Path(keep_dir) / f"replicate_{index:05d}"
             if dest.exists():
                 shutil.rmtree(dest)
             shutil.copytree(tmp, dest)
     return {"replicate": index, "drawn": drawn, "rows": rows_of(out, index),
-            "simulated_time_s": out.get("simulated_time_s")}
+            "simulated_time_s": out.get("simulated_time_s"), "timings": out.get("timings")}
 
 
 def default_executor(workers: int | None = None) -> cf.Executor:

@@ -326,6 +326,11 @@ class RangeRadar(Device):
         m = super().meta()
         m.update({"transponder_a": self.a.tolist(), "transponder_b": self.b.tolist(), "fix_side": self.side,
                   "station_survey_sd_m": self.survey_sd})
+        # the data sheet's range error per transponder and its time correlation, as (sd [m], correlation
+        # time [s]) pairs: the multipath's and the white part's (time 0), as the team has them
+        gm, noise = self.spec.get("gauss_markov") or {}, float(self.spec.get("noise", 0.0))
+        m["range_errors"] = ([[float(gm["sd"]) * self.f, float(gm["tau_s"])]] if gm.get("sd") else []) + \
+            ([[noise * self.f, 0.0]] if noise else [])
         return m
 
 

@@ -97,6 +97,31 @@ def read_groups(path: str | Path) -> dict:
     return out
 
 
+def groups_as_read(groups: dict, attrs: dict) -> dict:
+    """What :func:`read_groups` returns for a file that :func:`write_groups` would write from ``groups``
+    and ``attrs`` — without writing it: the same float64 arrays, units and attribute values (booleans
+    as integers, ``None`` as "", sequences as arrays), in the same order. A campaign replicate reduces
+    such in-memory records exactly as it would the files (tests/test_campaign_fastpath.py checks the
+    two are equal)."""
+
+    def attr(v):
+        v = _attr(v)
+        if isinstance(v, (list, tuple)):
+            v = np.asarray(v)
+        return _plain(v)
+
+    out = {"attrs": {k: attr(v) for k, v in attrs.items()}, "groups": {}}
+    for gname, g in groups.items():
+        variables = {"time": np.array(g["time"], dtype=np.float64)}
+        units = {"time": "s"}
+        for vname, (arr, u, _long_name) in g["variables"].items():
+            variables[vname] = np.array(arr, dtype=np.float64)
+            units[vname] = u
+        out["groups"][gname] = {"attrs": {k: attr(v) for k, v in g.get("attrs", {}).items()},
+                                "variables": variables, "units": units}
+    return out
+
+
 def _plain(v):
     if isinstance(v, np.ndarray) and v.ndim == 0:
         return v.item()
@@ -122,9 +147,9 @@ class Record:
     Opening a truth file raises :class:`RecordError`: reductions never read truth.
     """
 
-    def __init__(self, path: str | Path):
+    def __init__(self, path: str | Path, data: dict | None = None):
         self.path = Path(path)
-        data = read_groups(self.path)
+        data = read_groups(self.path) if data is None else data
         content = data["attrs"].get("content")
         if content != "record":
             raise RecordError(f"{self.path}: not a trial record (content = {content!r}); reductions read "
@@ -190,3 +215,9 @@ class Record:
 def open_record(path: str | Path) -> Record:
     """Open a trial record for reading (numpy arrays out)."""
     return Record(path)
+
+
+def record_in_memory(path: str | Path, groups: dict, attrs: dict) -> Record:
+    """The record :func:`write_groups` would write to ``path`` from ``groups`` and ``attrs``, as
+    :func:`open_record` would read it back — but nothing is written (:func:`groups_as_read`)."""
+    return Record(path, groups_as_read(groups, attrs))

@@ -73,10 +73,16 @@ def record_groups(iset, t_end: float, events: list[tuple[float, int, int]],
     return groups
 
 
-def write_record(path: Path, iset, t_end: float, events, orders, title: str, extra_attrs: dict,
-                 t_start: float = -np.inf, settings=None) -> None:
+def record_contents(iset, t_end: float, events, orders, title: str, extra_attrs: dict,
+                    t_start: float = -np.inf, settings=None) -> tuple[dict, dict]:
+    """(groups, global attributes) of a trial record (:func:`record_groups`; the file's attributes)."""
     attrs = {"Conventions": "CF-1.10", "title": title, "content": "record", "vtrials_version": __version__,
              "team_knowledge": json.dumps(iset.team, sort_keys=True),
              "time_reference": "seconds of the data acquisition system's clock from the start of the trial"}
     attrs.update({k: _json_attr(v) for k, v in extra_attrs.items()})
-    write_groups(path, record_groups(iset, t_end, events, orders, t_start, settings), attrs)
+    return record_groups(iset, t_end, events, orders, t_start, settings), attrs
+
+
+def write_record(path: Path, iset, t_end: float, events, orders, title: str, extra_attrs: dict,
+                 t_start: float = -np.inf, settings=None) -> None:
+    write_groups(path, *record_contents(iset, t_end, events, orders, title, extra_attrs, t_start, settings))

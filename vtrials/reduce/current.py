@@ -121,6 +121,216 @@ def ittc_mean_of_means(vg, std=None) -> Estimate:
     return mean_of_means(vg, std)
 
 
+# ==================================================================================================
+# joint fit of a standardization day: one speed per spot, one current for the day
+# ==================================================================================================
+def ship_scatter(solve, chi2: float, dof: int, resid, std):
+    """Run-to-run scatter τ of the ship's own speed (gusts, helm, a spot not quite settled) beyond the
+    tracking's stated σ, for a fit of speeds over ground: the one variance τ² common to the runs for
+    which χ² = dof when the runs are weighed by 1/(σᵢ² + τ²) (Paule & Mandel 1982, J. Res. NBS 87(5),
+    the consensus-mean estimator, applied to a fit). ``solve(τ)`` refits with those weights and returns
+    (w, weighted Jacobian, β, residuals, χ²); ``chi2`` is its χ² at τ = 0. Returns (τ, solve(τ))."""
+    if not (dof > 0 and chi2 > dof):
+        return 0.0, solve(0.0)
+    hi = float(np.max(np.abs(resid))) + float(np.max(std))
+    while solve(hi)[4] > dof:
+        hi *= 2.0
+    tau = optimize.brentq(lambda x: solve(x)[4] - dof, 0.0, hi, xtol=1e-9)
+    return float(tau), solve(tau)
+
+
+def scatter_budget(a, std, tau: float, ref, dof: int) -> tuple[float, float | None]:
+    """Standard uncertainty and dof of an estimate Σ aᵢ V_i of speeds V_i = Vᵢ* + eᵢ + δᵢ (eᵢ the tracking
+    error, σᵢ; δᵢ the ship's own scatter, τ) against the reference Σ w̃ᵢ Vᵢ* + δᵢ — the mean of the
+    same runs' true speeds, which carries their scatter too: u² = Σ aᵢ² σᵢ² + τ² Σ (aᵢ − w̃ᵢ)²; where the
+    fit weighs the runs as the reference does, the scatter cancels. Welch–Satterthwaite dof with the
+    τ part on the fit's dof (None: normal)."""
+    u_track = float(np.sum((np.asarray(a) * std) ** 2))
+    u_ship = tau ** 2 * float(np.sum((np.asarray(a) - ref) ** 2))
+    u2 = u_track + u_ship
+    nu = u2 ** 2 / (u_ship ** 2 / dof) if u_ship > 0 else None
+    return math.sqrt(u2), nu
+
+
+@dataclasses.dataclass(frozen=True)
+class SpotCurrentFit:
+    """Result of :func:`joint_spot_current_fit`.
+
+    groups: spot labels in order; vs: speed through water per spot (heading-balanced) [m/s], as
+    Estimates whose std is the scatter-scaled one (``scale`` × the stated-σ one) on ``dof``;
+    offset: per spot the half difference of the base- and reciprocal-course speeds over ground that the
+    current's time variation does not explain (the constant current along the course plus the
+    heading-dependent part of the ship's own speed, e.g. head and tail wind) [m/s]; model: current
+    shape ("tidal", "linear", "none"); shape: its coefficients [m/s] of ``basis`` (τ/T_span,
+    cos ωτ, sin ωτ); chi2 = Σ (r/σ)², dof = n − p; cov_stated: parameter covariance from the stated
+    σ alone (absolute); scale = max(1, χ²/dof) (Birge ratio: the scatter where it exceeds what the
+    stated σ allow)."""
+
+    groups: tuple
+    vs: tuple
+    offset: tuple
+    model: str
+    shape: np.ndarray
+    t_ref: float
+    t_span: float
+    period: float
+    chi2: float
+    dof: int
+    scale: float
+    residuals: np.ndarray
+    cov_stated: np.ndarray
+    ship_scatter: float = 0.0
+
+    def current_change(self, t) -> np.ndarray:
+        """The fitted time-varying part of the along-course current at times t [s] (m/s; its constant
+        is in the spots' offsets)."""
+        return _shape_basis(np.atleast_1d(np.asarray(t, float)), self.model, self.t_ref, self.t_span,
+                            self.period) @ self.shape
+
+
+_SHAPES = {"tidal": 3, "linear": 1, "none": 0}
+
+
+def _shape_basis(t, model, t_ref, t_span, period):
+    tau = np.asarray(t, float) - t_ref
+    cols = []
+    if model in ("tidal", "linear"):
+        cols.append(tau / t_span)
+    if model == "tidal":
+        cols += [np.cos(TWO_PI * tau / period), np.sin(TWO_PI * tau / period)]
+    return np.column_stack(cols) if cols else np.zeros((tau.size, 0))
+
+
+def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TIDAL_PERIOD,
+                           min_dof: int = 2, offsets: str | None = None) -> SpotCurrentFit:
+    """Speed through water of every spot of a standardization day from one weighted least-squares fit
+    of all its runs: V_G,i = V_g + sᵢ (d_g + c(tᵢ)), sᵢ = cos(φᵢ − φ₀) (±1 on the base course and its
+    reciprocal), one speed V_g and one offset d_g per spot, and the time variation c(t) of the current
+    along the course common to the day.
+
+    The current model is that of the ITTC iterative method (ITTC 7.5-04-01-01.1 (2017, rev. 2021):
+    V_C(t) = V_C,C cos ωτ + V_C,S sin ωτ + V_C,T τ + V_C,0, ω = 2π/12.42 h) without its constant: the
+    constant along-course current cannot be told from a spot's heading-dependent speed (the ship is
+    slower into the wind than with it: ~0.1 m/s for this 51-m ship in 20 kn), so each spot keeps its
+    own offset d_g and V_g is the heading-balanced mean — ½(mean over base-course runs + mean over
+    reciprocal runs) of the speed through water, the quantity a mean of means estimates. The common
+    part is the current's change with time, resolved from the spots' repeated courses (a three-run spot
+    B–R–B: V_G,1 − V_G,3 = c(t₁) − c(t₃)) across the whole day; with model "none" a three-run spot's V_g
+    is exactly the mean of means (V₁ + 2V₂ + V₃)/4 for equal σ. ``model`` None: the richest of "tidal"
+    (3 shape terms), "linear" (1), "none" with at least ``min_dof`` residual degrees of freedom (the
+    richest the runs determine at all when none has that many).
+    A two-run spot (one run each way) holds no contrast of its own; on a day of such spots the current's
+    change is only seen across spots, so ``offsets`` "common" (one offset for the day: the constant
+    current, with the heading-dependent speed taken equal at every spot) is tried after the per-spot
+    ("spot") forms; None: that order.
+
+    Unlike the ITTC iterative method there is no speed–power law in the fit: a power law across a CP
+    ship's combinator line cannot fit the spots, and its misfit is not measurement scatter.
+
+    Inputs: t [s] run mid-times, vg [m/s] speeds over ground, vg_std [m/s] their stated standard
+    uncertainty (tracking), heading [rad] (base course or its reciprocal), group the spot of each run.
+    Uncertainty (GUM, JCGM 100:2008; ITTC 7.5-02-01-01 for a least-squares fit): when the runs
+    scatter more than the stated σ allow, the excess is taken as run-to-run scatter τ of the ship's own
+    speed (gusts, helm, a big ship not quite settled; Paule–Mandel: χ² = dof) and the runs are weighed
+    by σᵢ² + τ². With V̂_g = Σ aᵢ V_G,i, the error against the spot's heading-balanced mean of its runs'
+    speeds (w̃) is Σ aᵢ eᵢ + Σ (aᵢ − w̃ᵢ) δᵢ: the tracking σ propagated, plus τ² Σ (aᵢ − w̃ᵢ)² — where
+    the fit weighs a spot's runs as that mean does, the ship's scatter is the reference's too and does
+    not count. Student t on the Welch–Satterthwaite dof (the τ part on the fit's dof); normal when the
+    runs scatter no more than stated. The stated σ must then be honest: the tracking fix statistics
+    with the data sheet's time-correlated error (:func:`vtrials.reduce.runstats.sog_from_track`).
+    """
+    t, vg, vg_std, heading = (np.asarray(a, dtype=float) for a in (t, vg, vg_std, heading))
+    n = vg.size
+    groups = tuple(sorted(set(group)))
+    G = len(groups)
+    gi = np.array([groups.index(g) for g in group])
+    s = np.cos(heading - heading[0])
+    if np.any(np.abs(s) < 0.5):
+        raise ValueError("runs must be on the base course or its reciprocal")
+    s = np.sign(s)
+    if np.any(~np.isfinite(vg_std)) or np.any(vg_std <= 0):
+        raise ValueError("every run needs a positive finite speed uncertainty")
+    t_ref = float(np.mean(t))
+    t_span = max(float(np.ptp(t)), 1.0)
+    V = np.column_stack([(gi == k).astype(float) for k in range(G)])
+    # a spot's offset only where it has runs on both courses (else it is its speed's twin)
+    both = [k for k in range(G) if len({float(x) for x in s[gi == k]}) == 2]
+    w = 1.0 / vg_std
+
+    def design(m, off):
+        if off == "spot":
+            D = np.column_stack([(gi == k) * s for k in both]) if both else np.zeros((n, 0))
+        else:
+            D = s[:, None]
+        return np.column_stack([V, D, s[:, None] * _shape_basis(t, m, t_ref, t_span, period)])
+
+    for m in ([] if model is None else [model]):
+        if m not in _SHAPES:
+            raise ValueError(f"model must be one of {tuple(_SHAPES)}")
+    if offsets not in (None, "spot", "common"):
+        raise ValueError("offsets must be 'spot' or 'common'")
+    shapes = [model] if model is not None else ["tidal", "linear"]
+    offs = [offsets] if offsets is not None else ["spot", "common"]
+    if offsets is None and all(np.count_nonzero(gi == k) >= 3 for k in range(G)):
+        offs = ["spot"]  # every spot has its own contrast: its own offset
+    order = [(m, o) for o in offs for m in shapes]
+    if model is None:
+        order.append(("none", offs[0]))
+    chosen = first = None
+    for m, o in order:
+        X = design(m, o)
+        p = X.shape[1]
+        if p > n or np.linalg.matrix_rank(X * w[:, None]) < p:
+            continue
+        first = first or (m, o)
+        if n - p >= min_dof:
+            chosen = (m, o)
+            break
+    chosen = chosen or first  # too few runs for min_dof: the richest form the runs determine
+    if chosen is None:
+        raise ValueError("the runs cannot determine a speed per spot")
+    X = design(*chosen)
+    if chosen[1] == "common":
+        both = [None]
+    chosen = chosen[0]
+    p = X.shape[1]
+    dof = n - p
+
+    def solve(tau):
+        wt = 1.0 / np.sqrt(vg_std ** 2 + tau ** 2)
+        Xw = X * wt[:, None]
+        beta, *_ = np.linalg.lstsq(Xw, vg * wt, rcond=None)
+        r = vg - X @ beta
+        return wt, Xw, beta, r, float(np.sum((r * wt) ** 2))
+
+    w, Xw, beta, r, chi2 = solve(0.0)
+    cov = np.linalg.pinv(Xw.T @ Xw)
+    scale = max(1.0, chi2 / dof) if dof > 0 else 1.0
+    tau, (w, Xw, beta, r, _) = ship_scatter(solve, chi2, dof, r, vg_std)
+    A = np.linalg.pinv(Xw) * w[None, :]  # β̂ = A v_G
+    vs = []
+    for k in range(G):
+        # the spot's reference is its heading-balanced mean of the runs' own speeds (what the fit's V_g
+        # means: vtrials.score.trials.spot_stw_truth)
+        m = gi == k
+        wt_ref = np.zeros(n)
+        for c in (-1.0, 1.0):
+            mc = m & (s == c)
+            if mc.any():
+                wt_ref[mc] = 1.0 / mc.sum()
+        vs.append(Estimate(float(beta[k]), *scatter_budget(A[k], vg_std, tau, wt_ref / wt_ref.sum(), dof)))
+    vs = tuple(vs)
+    off = [math.nan] * G
+    for j, k in enumerate(both):
+        if k is None:  # one offset for the day
+            off = [float(beta[G])] * G
+        else:
+            off[k] = float(beta[G + j])
+    return SpotCurrentFit(groups=groups, vs=vs, offset=tuple(off), model=chosen, shape=beta[G + len(both):],
+                          t_ref=t_ref, t_span=t_span, period=float(period), chi2=chi2, dof=dof, scale=scale,
+                          residuals=r, cov_stated=cov, ship_scatter=float(tau))
+
+
 @dataclasses.dataclass(frozen=True)
 class PolyCurrentResult:
     vs: Estimate  # speed through water [m/s]

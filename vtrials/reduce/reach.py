@@ -334,6 +334,7 @@ def _metrics(tg, s, y, vs, vy, dpsi_g, U0, tail_t, s_tail, y_tail, band_fraction
         g0, g1 = abs(U[k] - UT) - band, abs(U[k + 1] - UT) - band
         a = g0 / (g0 - g1) if g0 != g1 else 1.0
         te = tg[k] + a * (tg[k + 1] - tg[k])
+        out["a_term"] = float((U[k + 1] - U[k]) / (tg[k + 1] - tg[k]))
     out["t_term"] = te
     if te is not None:
         out["s_term"] = float(np.interp(te, tg, s))
@@ -635,7 +636,14 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         te = base["t_term"]
         el = te - t_execute
         sD_u = math.sqrt(float(uvec @ SD @ uvec))
-        res.time_to_terminal_speed = Estimate(el, math.hypot(bstd("t_term"), timing_sd))
+        # the band's edge U_T ∓ 0.02 (U_T − U_0) moves with the two speeds' window errors that the
+        # bootstrap of white residuals does not see (the tracking's time-correlated error over the tail
+        # and the approach); the entry moves by that over the acceleration there — small at the end of
+        # an exponential approach, so this instant is ill-conditioned and its interval says so
+        lvl = 0.98 ** 2 * var_fix_tail + 0.02 ** 2 * var_fix_app
+        a_t = abs(base.get("a_term", 0.0))
+        extra = lvl / a_t ** 2 if a_t > 0.0 else 0.0
+        res.time_to_terminal_speed = Estimate(el, math.sqrt(bstd("t_term") ** 2 + extra + timing_sd ** 2))
         res.reach_at_terminal = Estimate(base["s_term"], math.sqrt(bstd("s_term") ** 2 + (el * sD_u) ** 2))
         res.track_distance_at_terminal = Estimate(base["path_term"],
                                                   math.sqrt(bstd("path_term") ** 2 + (el * sD_u) ** 2))

@@ -199,7 +199,25 @@ class TrackFit:
     t_mid: float  # mean time of the samples used [s]
 
 
-def sog_from_track(t, north, east, t0=None, t1=None) -> TrackFit:
+def exp_kernel_form(t, x, tau: float) -> float:
+    """xᵀ R x with R_ij = exp(−|t_i − t_j|/τ) for increasing times t [s] (τ = 0: R = I, white).
+
+    O(n) by the exponential kernel's Markov property: with y_i = x_i + e^{−(t_i − t_{i−1})/τ} y_{i−1},
+    Σ_{j≤i} R_ij x_j = y_i, so xᵀ R x = 2 Σ x_i y_i − Σ x_i² — exact for any sampling."""
+    t = np.asarray(t, float)
+    x = np.asarray(x, float)
+    if tau <= 0:
+        return float(np.dot(x, x))
+    f = np.exp(-np.diff(t) / tau)
+    y = np.empty_like(x)
+    acc = 0.0
+    for i in range(x.size):
+        acc = x[i] + (f[i - 1] * acc if i else 0.0)
+        y[i] = acc
+    return float(2.0 * np.dot(x, y) - np.dot(x, x))
+
+
+def sog_from_track(t, north, east, t0=None, t1=None, fix_errors=()) -> TrackFit:
     """Speed and course over ground from positions [m] against time [s] in the window [t0, t1].
 
     Least-squares straight line north = n₀ + v_N t, east = e₀ + v_E t (the range/tracking method of
@@ -211,7 +229,22 @@ def sog_from_track(t, north, east, t0=None, t1=None) -> TrackFit:
     truncated autocovariance of that residual component (module docstring), so se(SOG) is the
     along-track slope error and se(COG) = cross-track slope error / SOG. The small correlation between
     the two components is neglected. dof = n_eff − 2.
+
+    ``fix_errors``: what the tracking system's data sheet says of its fix errors, as (G, sd, τ)
+    triples — an error source of standard deviation sd with exponential time correlation τ [s] (0:
+    white), and G (n × 2, one row per sample of t) the position error (north, east) [m] per unit of
+    it (the geometry: e.g. a range error maps into the fix through the two range lines). The slope's
+    variance under that model, Σ_k sd_k² (w∘g_k)ᵀ R_k (w∘g_k) with g_k = G_k u (u the along- or
+    cross-track unit vector), is a type-B evaluation (GUM, JCGM 100:2008 §4.3); it is used when it
+    exceeds the residuals' sandwich value — the sample autocovariance of a window a few correlation
+    times long is biased low (module docstring), so a 30-s multipath on a 5-min run is otherwise
+    understated by ~1.7× — and the interval is then normal (no dof of its own).
     """
+    if fix_errors:
+        tt = np.asarray(t, float)
+        keep = (tt >= (-math.inf if t0 is None else t0)) & (tt <= (math.inf if t1 is None else t1))
+        keep &= np.isfinite(tt) & np.isfinite(np.asarray(north, float)) & np.isfinite(np.asarray(east, float))
+        fix_errors = [(np.asarray(G, float)[keep], float(sd), float(tau)) for G, sd, tau in fix_errors]
     ts, n_, e_ = _window(t, t0, t1, north, east)
     n = ts.size
     if n < 3:
@@ -240,13 +273,23 @@ def sog_from_track(t, north, east, t0=None, t1=None) -> TrackFit:
         neff = float(np.clip(n * var_white / var, 2.0, n)) if var > 0 else float(n)
         return var, neff
 
+    def model_var(u):
+        return sum(sd * sd * exp_kernel_form(ts, w * (G @ u), tau) for G, sd, tau in fix_errors)
+
     var_al, neff_al = slope_var(r_al)
     var_cr, neff_cr = slope_var(r_cr)
+    dof_al, dof_cr = max(neff_al - 2.0, 1.0), max(neff_cr - 2.0, 1.0)
+    if fix_errors:
+        m_al, m_cr = model_var(np.array(ua)), model_var(np.array((-ua[1], ua[0])))
+        if m_al > var_al:
+            var_al, dof_al = m_al, None
+        if m_cr > var_cr:
+            var_cr, dof_cr = m_cr, None
     se_sog = math.sqrt(var_al)
     se_cog = math.sqrt(var_cr) / sog if sog > 0 else math.inf
     return TrackFit(
-        sog=Estimate(sog, se_sog, max(neff_al - 2.0, 1.0)),
-        cog=Estimate(cog, se_cog, max(neff_cr - 2.0, 1.0)),
+        sog=Estimate(sog, se_sog, dof_al),
+        cog=Estimate(cog, se_cog, dof_cr),
         v_north=vn, v_east=ve,
         along_rms=float(np.sqrt(np.mean(r_al ** 2))),
         cross_rms=float(np.sqrt(np.mean(r_cr ** 2))),

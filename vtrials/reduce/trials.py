@@ -15,10 +15,11 @@ sensor positions, nominal calibrations) and the tank prediction in the record's 
   spots, curve), as a trials team reports it; the direct power method is applied to it (its
   corrections are power increments at unchanged r/min, where the stern-tube loss, a function of r/min,
   does not change). The scoring reference is the same quantity (vtrials/score/trials.py).
-* :func:`reduce_standardization` — per spot: current elimination over its runs (two-run average,
-  1:2:1 mean of means, ITTC mean of means), with the run-to-run scatter the all-runs ITTC iterative
-  analysis leaves added to the tracking uncertainty; power corrected per run for the wind by the
-  direct power method (R_AA from the measured relative wind and the ship's coefficients, η_D from the
+* :func:`reduce_standardization` — the spots' speeds through water from one joint fit of the day's
+  runs (a speed per spot, the current's change with time common to the day:
+  :func:`vtrials.reduce.current.joint_spot_current_fit`; its budget is the tracking uncertainty
+  propagated through the fit, scaled by the fit's own scatter on its dof); power corrected per run for
+  the wind by the direct power method (R_AA from the measured relative wind and the ship's coefficients, η_D from the
   tank prediction); speed–power, r/min, torque and thrust against speed through water (cubic in
   log–log, a power law whose exponent may vary with speed); the ITTC iterative method over all runs as
   the alternative analysis.
@@ -65,6 +66,37 @@ def _angular(kind: str, channel: str) -> bool:
     return channel in ("heading", "cog") or (kind == "anemometer" and channel == "angle")
 
 
+def _fix_errors(meta: dict, north, east) -> list:
+    """The tracking system's fix errors as its data sheet gives them, in the form
+    :func:`vtrials.reduce.runstats.sog_from_track` takes: (G, sd, τ) per error source.
+
+    Range–range radar: each transponder's range error (multipath, white) maps into the fix through
+    the two range lines, δp = M⁻¹ δr with M's rows the unit vectors from the surveyed stations to the
+    fix (the geometric dilution the fix suffers where the lines cross at a narrow angle). GNSS: the
+    stated correlated parts per axis, and the rest of the stated horizontal accuracy as white."""
+    north, east = np.asarray(north, float), np.asarray(east, float)
+    kind = meta.get("kind")
+    if kind == "range_radar" and meta.get("range_errors"):
+        p = np.column_stack([north, east])
+        ua = p - np.asarray(meta["transponder_a"], float)
+        ub = p - np.asarray(meta["transponder_b"], float)
+        ua /= np.linalg.norm(ua, axis=1)[:, None]
+        ub /= np.linalg.norm(ub, axis=1)[:, None]
+        det = ua[:, 0] * ub[:, 1] - ua[:, 1] * ub[:, 0]
+        if np.any(np.abs(det) < 1e-6):
+            return []  # on the baseline: the fix has no geometry (the residuals' statistics only)
+        # M = [ua; ub] (2×2 per sample): columns of M⁻¹ = the fix's response to each range's error
+        g_a = np.column_stack([ub[:, 1], -ub[:, 0]]) / det[:, None]
+        g_b = np.column_stack([-ua[:, 1], ua[:, 0]]) / det[:, None]
+        return [(g, sd, tau) for sd, tau in meta["range_errors"] for g in (g_a, g_b)]
+    if kind == "gnss" and meta.get("horizontal_accuracy_m"):
+        corr = [tuple(map(float, x)) for x in meta.get("correlated_errors", [])]
+        white = math.sqrt(max(float(meta["horizontal_accuracy_m"]) ** 2 - sum(sd * sd for sd, _ in corr), 0.0))
+        axes = (np.tile([1.0, 0.0], (north.size, 1)), np.tile([0.0, 1.0], (north.size, 1)))
+        return [(g, sd, tau) for sd, tau in corr + [(white, 0.0)] if sd > 0 for g in axes]
+    return []
+
+
 def accepted_runs(rec: Record) -> list[dict]:
     """The log sheet's accepted runs, in run order (one entry per run number)."""
     return sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
@@ -98,7 +130,8 @@ def run_statistics(rec: Record, run: dict) -> dict:
             _, e = rec.channel(name, "east")
             ok = np.isfinite(n) & np.isfinite(e)
             try:
-                fit = RS.sog_from_track(t[ok], n[ok], e[ok], t0, t1)
+                fit = RS.sog_from_track(t[ok], n[ok], e[ok], t0, t1,
+                                        fix_errors=_fix_errors(rec.meta(name), n[ok], e[ok]))
                 out["sog"][name] = {"sog": _est(fit.sog), "cog": _est(fit.cog), "kind": kind,
                                     "along_rms": fit.along_rms, "cross_rms": fit.cross_rms, "n": fit.n}
             except ValueError:
@@ -237,10 +270,70 @@ def _xi_p(tank: dict, v):
     return float(np.interp(v, tank["speed_mps"], tank["xi_P"]))
 
 
+def _tank_log_slope(tank: dict):
+    """v ↦ d ln P / d ln V of the tank prediction's power (central differences between its speeds,
+    interpolated; 3 — the cubic law — where the record has no tank prediction)."""
+    if not tank or len(tank.get("speed_mps", [])) < 2:
+        return lambda v: 3.0
+    lv, lp = np.log(tank["speed_mps"]), np.log(tank["power_W"])
+    q = np.gradient(lp, lv)
+    return lambda v: float(np.interp(math.log(max(v, 1e-9)), lv, q))
+
+
 # ----------------------------------------------------------------------------------- standardization
+def _along_course(run: dict) -> Estimate:
+    """A run's speed over ground along its course line, V_G cos(χ − ψ_c) [m/s] (χ the course over
+    ground, ψ_c the run's nominal course): the distance made good along the measured course per unit
+    time, which is what the current elimination's V_G = V_S ± V_C assumes. The track's speed magnitude
+    carries the cross-course current as well, √((V_S + V_C∥)² + V_C⊥²) ≈ V_S + V_C∥ + V_C⊥²/2V_S — a
+    bias the mean of means cannot remove (0.01 m/s for a 5 m/s ship in a 0.35 m/s cross tide). Standard
+    uncertainty from the speed's and the course's (first-order propagation)."""
+    s = run["sog"][run["tracking"]]
+    if "cog" not in s:  # a log's displayed speed: no course of its own (the magnitude is all there is)
+        return run["vg"]
+    v, sv = run["vg"].value, run["vg"].std
+    d = s["cog"]["value"] - run["course"]
+    sd = s["cog"]["std"]
+    c = math.cos(d)
+    return Estimate(v * c, math.hypot(c * sv, v * math.sin(d) * sd), run["vg"].dof)
+
+
+OFF_COURSE = math.radians(20.0)  # a run's track this far from its ordered course is not on the measured course
+
+
+def _runs_on_the_course(rec: Record, runs: list[dict]) -> tuple[list[dict], list[dict]]:
+    """The runs the speed analysis may use, and those it sets aside with the reason.
+
+    ITTC 7.5-04-01-01.1 (2017) §5: runs that do not meet the steadiness criteria are rejected. A run
+    the director flagged unsteady (the log sheet: the approach never settled and the run went ahead)
+    is set aside when its spot keeps a run on each course without it; and a run whose track is more
+    than 20° off its ordered course (a slow ship that could not hold its heading in a strong beam
+    wind) is not on the measured course at all, whatever the log sheet says."""
+    log = {r["run"]: r for r in accepted_runs(rec)}
+    out, bad = [], []
+    for r in runs:
+        s = r["sog"][r["tracking"]]
+        off = abs(RS.wrap_pi(s["cog"]["value"] - r["course"])) if "cog" in s else 0.0
+        if off > OFF_COURSE:
+            bad.append({"run": r["run"], "reason": f"track {math.degrees(off):.0f}° off the ordered course"})
+        else:
+            out.append(r)
+    keep = []
+    for r in out:
+        if not r["steady"]:
+            others = [x for x in out if x["group"] == r["group"] and x is not r and x["steady"]]
+            sides = {math.copysign(1.0, math.cos(x["course"] - r["course"])) for x in others}
+            if sides == {1.0, -1.0}:
+                notes = "; ".join(log[r["run"]]["approach_notes"] + log[r["run"]]["run_notes"])
+                bad.append({"run": r["run"], "reason": f"flagged unsteady ({notes})"})
+                continue
+        keep.append(r)
+    return keep, bad
+
+
 def reduce_standardization(rec: Record) -> dict:
     team = rec.team
-    runs = [run_statistics(rec, r) for r in accepted_runs(rec)]
+    runs, excluded = _runs_on_the_course(rec, [run_statistics(rec, r) for r in accepted_runs(rec)])
     if not runs:
         raise ValueError(f"{rec.path}: no accepted runs")
     groups = sorted({r["group"] for r in runs})
@@ -249,36 +342,34 @@ def reduce_standardization(rec: Record) -> dict:
     rho_air = 1.225
     disp = (rec.attr("condition", {}) or {}).get("displacement_m3") or team.get("displacement_m3")
     rho_w = float(team.get("water_density", 1025.0))
-    # all-runs ITTC iterative analysis (tidal current model when the runs allow it): its residual
-    # scatter is the run-to-run variability the per-spot eliminations cannot see
+    for r in runs:
+        r["vg_course"] = _along_course(r)
     tt = np.array([r["t_mid"] for r in runs])
-    vg = np.array([r["vg"].value for r in runs])
-    vg_se = np.array([r["vg"].std for r in runs])
+    vg = np.array([r["vg_course"].value for r in runs])
+    vg_se = np.array([r["vg_course"].std for r in runs])
     hd = np.array([r["course"] for r in runs])
     pw = np.array([r["power"].value for r in runs])
+    # the spots' speeds through water: one joint fit of every run (a speed per spot, the day's current)
+    joint = CUR.joint_spot_current_fit(tt, vg, vg_se, hd, [r["group"] for r in runs])
+    stw = dict(zip(joint.groups, joint.vs))
+    # the ITTC iterative analysis over all runs, as the alternative analysis (its power law across a CP
+    # ship's combinator line is model error: nothing of it enters the spots' budgets)
     iterative = None
-    for model in ("tidal", "linear", "constant"):
+    for model, k in (("tidal", 4), ("linear", 2), ("constant", 1)):
+        if len(runs) - (k + 3) < 2:
+            continue
         try:
-            it = CUR.ittc_iterative(tt, vg, hd, pw, model=model)
-            if it.dof >= 2:
-                iterative = it
-                break
+            iterative = CUR.ittc_iterative(tt, vg, hd, pw, model=model)
+            break
         except (ValueError, np.linalg.LinAlgError, RuntimeError):
             continue
-    sigma_run = 0.0
-    if iterative is not None:
-        # speed residual of each run about the fitted curve (power residual / slope of the curve)
-        vs = np.asarray(iterative.vs)
-        slope = iterative.b.value * iterative.q.value * vs ** (iterative.q.value - 1)
-        resid_v = (pw - iterative.power(vs)) / slope
-        sigma_run = float(math.sqrt(max(np.sum(resid_v ** 2) / iterative.dof - np.mean(vg_se ** 2), 0.0)))
+    slope = _tank_log_slope(tank)
     spots = []
     for g in groups:
         rs = [r for r in runs if r["group"] == g]
         n = len(rs)
-        v = [r["vg"].value for r in rs]
-        sv = [math.hypot(r["vg"].std, sigma_run) for r in rs]
-        vs = _mom(v, sv)
+        v = [r["vg_course"].value for r in rs]
+        vs = stw[g]
         p_ms = np.array([r["power"].value for r in rs])
         p_ms_se = np.array([r["power"].std for r in rs])
         # wind: R_AA per run from the measured relative wind, then the direct power method
@@ -319,14 +410,14 @@ def reduce_standardization(rec: Record) -> dict:
                                                    delta_r_std=d_r_se, xi_p=xi)
         else:
             p_id, p_id_se = p_ms, p_ms_se
-        # run-to-run power scatter at equal settings (gusts, helm) as seen after the correction
         w = CUR.mean_of_means_weights(n)
-        P = _mom(p_id, np.hypot(p_id_se, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0))
         P_ms = _mom(p_ms, p_ms_se)
         # the torsionmeters' calibration uncertainty is common to the spot's runs: added after averaging
         cal = float(np.mean([r.get("power_calibration_std", 0.0) for r in rs]))
-        P = Estimate(P.value, math.hypot(P.std, cal), P.dof)
         P_ms = Estimate(P_ms.value, math.hypot(P_ms.std, cal), P_ms.dof)
+        # a curve point is the power AT the reduced speed: the speed's uncertainty moves along the curve
+        # by its slope, d ln P / d ln V of the tank prediction (3 for a cubic law where there is none)
+        p_speed = float(np.dot(w, p_id)) * slope(vs.value) * vs.std / vs.value
         rps = _mom([np.mean([float(s["rps"]["mean"]) for s in r["shafts"].values() if s.get("rps")]) for r in rs],
                    [1e-3] * n)
         torque = float(np.dot(w, [sum(s["torque"]["mean"] for s in r["shafts"].values() if s.get("torque"))
@@ -336,14 +427,17 @@ def reduce_standardization(rec: Record) -> dict:
                                                        for r in rs) else None
         s_i = np.cos(np.array([r["course"] for r in rs]) - rs[0]["course"])
         current_along = [float(si * (vgi - vs.value)) for si, vgi in zip(s_i, v)]
-        spots.append({"group": g, "runs": [r["run"] for r in rs], "n_runs": n, "method": _method_name(n),
-                      "stw": _est(vs), "power_measured": _est(P_ms), "power": _est(P),
+        spots.append({"group": g, "runs": [r["run"] for r in rs], "n_runs": n,
+                      "method": f"joint fit of the day's runs (current change: {joint.model})",
+                      "stw": _est(vs), "power_measured": _est(P_ms), "power": None,
+                      "power_speed_std": p_speed, "power_calibration_std": cal,
+                      "_corrected": (np.asarray(p_id, float), np.asarray(p_id_se, float), np.sign(s_i), vs.dof),
                       "rps": rps.value, "torque": torque, "thrust": thrust,
                       "current_along_base": current_along, "wind": wind_used, "waves": waves_used,
                       "eta_D": None if eta is None else float(eta), "xi_P": xi,
                       "r_acc": [float(x) for x in np.atleast_1d(r_acc)],
                       "steady": all(r["steady"] for r in rs)})
-    _two_run_trend_correction(spots, runs)
+    _spot_powers(spots)
     # the faired speed–power curve: monotone cubic through the spots in log–log (trial practice fairs
     # the curve through the spots; a global law — the ITTC power law below — cannot follow a resistance
     # hump to 1 %)
@@ -360,13 +454,18 @@ def reduce_standardization(rec: Record) -> dict:
                               "rel_std": s["power"]["std"] / s["power"]["value"]}
     runs_out = []
     for r in runs:
-        d = {k: v for k, v in r.items() if k not in ("vg", "power")}
+        d = {k: v for k, v in r.items() if k not in ("vg", "vg_course", "power")}
         d["vg"] = _est(r["vg"])
+        d["vg_course"] = _est(r["vg_course"])
         pw = r.get("power")
         d["power"] = None if pw is None else _est(Estimate(pw.value, math.hypot(pw.std, r.get("power_calibration_std", 0.0))))
         runs_out.append(d)
     out = {"kind": "standardization", "tracking": runs[0]["tracking"], "runs": runs_out, "spots": spots,
-           "curve": curve, "sigma_run_mps": sigma_run}
+           "curve": curve, "excluded_runs": excluded,
+           "joint_fit": {"current_model": joint.model, "dof": joint.dof, "chi2": joint.chi2,
+                         "birge_ratio": math.sqrt(joint.scale), "offsets": list(joint.offset),
+                         "current_change": [float(x) for x in joint.current_change(tt)],
+                         "residuals": [float(x) for x in joint.residuals], "runs": [r["run"] for r in runs]}}
     if iterative is not None:
         out["ittc_iterative"] = {"model": iterative.model, "vs": list(map(float, iterative.vs)),
                                  "vs_std": list(map(float, iterative.vs_std)),
@@ -374,6 +473,51 @@ def reduce_standardization(rec: Record) -> dict:
                                  "a": _est(iterative.a), "b": _est(iterative.b), "q": _est(iterative.q),
                                  "dof": iterative.dof, "runs": [r["run"] for r in runs]}
     return out
+
+
+def _spot_powers(spots: list[dict]) -> None:
+    """Each spot's corrected power (mean of means of its runs' direct-power-method powers) and its
+    budget, named term by term (GUM, JCGM 100:2008; ITTC 7.5-02-01-01):
+
+    * run-to-run scatter of the corrected power (gusts, helm, sea): the relative scatter of runs on the
+      SAME course at the same spot, pooled over the day's spots (dof = number of such repeats less one
+      per course and spot). Runs on opposite courses differ for a real reason — into the wind the ship is
+      slower and needs less power at the same settings (~q ΔV/V, several per cent at low speed) — which
+      the mean of means balances and which is not scatter. A day without same-course repeats (two-run
+      spots) falls back to the spot's own scatter std/√2 over both courses (conservative);
+    * each run's standard error of its mean power and the uncertainty of its resistance corrections
+      (wind coefficient, relative wind, acceleration: :func:`vtrials.reduce.speedpower.direct_power_method`);
+    * the torsionmeters' zero and scale calibration, common to the spot's runs;
+    * the spot speed's uncertainty carried along the curve (``power_speed_std``).
+
+    The interval is Student-t on the Welch–Satterthwaite dof of the scatter and speed terms."""
+    ss, dof = 0.0, 0
+    for sp in spots:
+        p_id, _, sgn, _ = sp["_corrected"]
+        for c in (-1.0, 1.0):
+            x = p_id[sgn == c]
+            if x.size >= 2:
+                rel = x / x.mean() - 1.0
+                ss += float(np.sum(rel ** 2))
+                dof += x.size - 1
+    sigma_rel = math.sqrt(ss / dof) if dof > 0 else None
+    for sp in spots:
+        p_id, p_id_se, sgn, v_dof = sp.pop("_corrected")
+        n = p_id.size
+        w = CUR.mean_of_means_weights(n) if n > 1 else np.ones(1)
+        if sigma_rel is not None:
+            scatter, nu = sigma_rel * p_id, dof
+        else:
+            scatter, nu = np.full(n, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0), max(n - 1, 1)
+        value = float(np.dot(w, p_id))
+        u_scatter2 = float(np.sum((w * scatter) ** 2))
+        u_runs2 = float(np.sum((w * p_id_se) ** 2))
+        u_speed = sp["power_speed_std"]
+        u2 = u_scatter2 + u_runs2 + sp["power_calibration_std"] ** 2 + u_speed ** 2
+        den = u_scatter2 ** 2 / nu + (u_speed ** 4 / v_dof if v_dof else 0.0)
+        nu_eff = u2 ** 2 / den if den > 0 else None
+        sp["power"] = Estimate(value, math.sqrt(u2), nu_eff).to_dict()
+        sp["power_scatter_rel_std"] = None if sigma_rel is None else sigma_rel
 
 
 def curve_power(curve: dict, v) -> np.ndarray:
@@ -384,47 +528,15 @@ def curve_power(curve: dict, v) -> np.ndarray:
     return np.exp(f(np.log(np.asarray(v, float))))
 
 
-def _two_run_trend_correction(spots: list[dict], runs: list[dict]) -> None:
-    """A two-run average assumes a constant current; a current changing at ċ leaves an error
-    −s₁ ċ Δt/2 (s₁ = ±1 the first run's sense along the base course, Δt between the runs). When the
-    trial has other spots, ċ is the slope of the along-course current they imply against time (a
-    straight line through the spots' implied currents), and two-run spots are corrected by it, with
-    its uncertainty added (seed 002 allows two-run spots only in weak, steady currents)."""
-    if len(spots) < 2 or not any(s["n_runs"] == 2 for s in spots):
-        return
-    byrun = {r["run"]: r for r in runs}
-    c0 = runs[0]["course"]
-    tt, cc = [], []
-    for s in spots:
-        rs = [byrun[k] for k in s["runs"]]
-        for r, c in zip(rs, s["current_along_base"]):
-            sgn = math.cos(rs[0]["course"] - c0)  # express along the trial's first course
-            tt.append(r["t_mid"])
-            cc.append(c * sgn)
-    tt, cc = np.array(tt), np.array(cc)
-    if np.ptp(tt) <= 0 or tt.size < 4:
-        return
-    A = np.column_stack([np.ones_like(tt), tt - tt.mean()])
-    coef, res, *_ = np.linalg.lstsq(A, cc, rcond=None)
-    dof = tt.size - 2
-    s2 = float(np.sum((cc - A @ coef) ** 2)) / dof if dof > 0 else 0.0
-    rate, rate_se = float(coef[1]), math.sqrt(s2 / float(np.sum((tt - tt.mean()) ** 2)))
-    for s in spots:
-        if s["n_runs"] != 2:
-            continue
-        r1, r2 = byrun[s["runs"][0]], byrun[s["runs"][1]]
-        s1 = math.cos(r1["course"] - c0)
-        dt = r2["t_mid"] - r1["t_mid"]
-        corr = s1 * rate * dt / 2.0
-        st = s["stw"]
-        s["stw"] = Estimate(st["value"] + corr, math.hypot(st["std"], rate_se * dt / 2.0)).to_dict()
-        s["method"] = "two-run average, corrected for the current trend of the trial's spots"
-        s["trend_correction"] = corr
-
-
 # ----------------------------------------------------------------------------------- log calibration
-def _joint_current_fit(t, heading, vg, group, trend: bool):
-    """|U_g h_i + c(t_i)| least squares: parameters U per group, c_N, c_E (and their rates)."""
+def _joint_current_fit(t, heading, vg, vg_std, group, trend: bool):
+    """|U_g h_i + c(t_i)| least squares: parameters U per group, c_N, c_E (and their rates).
+
+    Legs weighed by 1/(σᵢ² + τ²), τ the ship's own leg-to-leg speed scatter beyond the tracking's stated
+    σ (:func:`vtrials.reduce.current.ship_scatter`). The groups' speeds carry the tracking σ through
+    the (linearised) fit and τ only through their difference from the group's plain mean of its legs
+    — the reference, whose legs scatter alike (:func:`vtrials.reduce.current.scatter_budget`); the
+    current's covariance is the weighted fit's, scaled to χ²/dof = 1."""
     groups = sorted(set(group))
     gi = np.array([groups.index(g) for g in group])
     G = len(groups)
@@ -438,13 +550,25 @@ def _joint_current_fit(t, heading, vg, group, trend: bool):
         return np.hypot(U * hc + cn, U * hs + ce)
 
     x0 = np.concatenate([[np.mean(vg[gi == k]) for k in range(G)], [0.0, 0.0], [0.0, 0.0] if trend else []])
-    res = optimize.least_squares(lambda x: model(x) - vg, x0, method="lm", xtol=1e-14, ftol=1e-14)
-    J = res.jac
     n, p = vg.size, x0.size
     dof = n - p
-    s2 = float(res.fun @ res.fun) / dof if dof > 0 else math.nan
+
+    def solve(tau):
+        w = 1.0 / np.sqrt(vg_std ** 2 + tau ** 2)
+        res = optimize.least_squares(lambda x: (model(x) - vg) * w, x0, method="lm", xtol=1e-14, ftol=1e-14)
+        return w, res.jac, res.x, res.fun / w, float(res.fun @ res.fun)
+
+    fit0 = solve(0.0)
+    tau, (w, J, x, r, chi2) = CUR.ship_scatter(solve, fit0[4], dof, fit0[3], vg_std)
+    s2 = chi2 / dof if dof > 0 else math.nan
     cov = np.linalg.pinv(J.T @ J) * s2
-    return groups, res.x, cov, dof, tm, res.fun
+    A = np.linalg.pinv(J) * w[None, :]
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    Ug = []
+    for k in range(G):
+        ref = (gi == k) / float(np.count_nonzero(gi == k))
+        Ug.append(CUR.scatter_budget(A[k], vg_std, tau, ref, dof))
+    return groups, x, cov, sd, Ug, dof, tm, r, tau
 
 
 def reduce_log_calibration(rec: Record) -> dict:
@@ -577,15 +701,14 @@ def resolve_current(t, heading, vg, vg_std, group):
     p = G + (4 if trend else 2)
     rank = int(np.linalg.matrix_rank(design(trend)))
     if n > p and rank == p:
-        groups, x, cov, dof, tm, resid = _joint_current_fit(t, heading, vg, group, trend)
-        sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-        U = {g: Estimate(float(x[k]), float(sd[k]), dof) for k, g in enumerate(groups)}
+        groups, x, cov, sd, Ug, dof, tm, resid, tau = _joint_current_fit(t, heading, vg, vg_std, group, trend)
+        U = {g: Estimate(float(x[k]), *Ug[k]) for k, g in enumerate(groups)}
         cur = {"north": Estimate(float(x[G]), float(sd[G]), dof),
                "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof), "trend": trend, "t_ref": tm}
         if trend:
             cur["north_rate"] = Estimate(float(x[G + 2]), float(sd[G + 2]), dof)
             cur["east_rate"] = Estimate(float(x[G + 3]), float(sd[G + 3]), dof)
-        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend}, []
+        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend, "ship_scatter": tau}, []
     if rank < p:
         axes = sorted({round(math.degrees(h) % 180.0, 1) for h in heading})
         why = (f"the legs lie on {'one axis' if len(axes) == 1 else 'too few axes'} "

@@ -26,11 +26,11 @@ from vtrials import __version__
 from vtrials.trials.crew import Crew
 from vtrials.errors import InputError, SimulationError
 from vtrials.instruments.sea_observation import observe_sea
-from vtrials.records.netcdf import atomic_path, open_record, write_groups
+from vtrials.records.netcdf import atomic_path, open_record, record_in_memory, write_groups
 from vtrials.scenario import Scenario, environment_block, hydro_path, instrument_set, sea_vessel, wave_field
 from vtrials.runner.outputs import json_clean
 from vtrials.physics.simulator import ShipState, Simulator
-from vtrials.records.trial import write_record
+from vtrials.records.trial import record_contents
 from vtrials.truth.calmwater import load_variation
 from vtrials.truth.columns import describe
 from vtrials.units import DEG, RPM
@@ -215,11 +215,12 @@ def write_agenda_truth(res: AgendaResult, path: Path) -> None:
                                           "midship waterline"})
 
 
-def write_trial_records(res: AgendaResult, out: Path) -> dict:
-    """One record per trial: the instruments over the trial's span, its events, orders and log sheet."""
+def trial_record_contents(res: AgendaResult) -> dict:
+    """Per trial: (groups, attributes) of its record — the instruments over the trial's span, its events,
+    orders and log sheet (:func:`vtrials.records.trial.record_contents`)."""
     crew = res.crew
     s = res.scenario
-    paths = {}
+    out = {}
     for trial in s.agenda.trials:
         name = trial.head.name
         atts = [a for a in crew.attempts if a.run.trial == name]
@@ -237,17 +238,33 @@ def write_trial_records(res: AgendaResult, out: Path) -> dict:
             if before:
                 settings.insert(0, (t0, *before[-1][1:]))
         head = trial.head
+        out[name] = record_contents(
+            crew.iset, t1, events, orders, f"vtrials trial record: {name} ({head.kind}) — {s.head.title}",
+            {"trial": name, "kind": head.kind, "ship": s.vessel.name, "scenario_file": s.path.name,
+             "run_log": [a.log() for a in atts],
+             "condition": {"displacement_m3": head.displacement_m3 or s.vessel.particulars.displacement,
+                           "trim_m": head.trim_m},
+             "tank_prediction": tank_prediction(s.vessel)},
+            t_start=t0, settings=sorted(settings))
+    return out
+
+
+def write_trial_records(res: AgendaResult, out: Path) -> dict:
+    """One record file per trial (:func:`trial_record_contents`) under out/records; {trial: path}."""
+    paths = {}
+    for name, (groups, attrs) in trial_record_contents(res).items():
         path = out / "records" / f"{name}.nc"
-        write_record(path, crew.iset, t1, events, orders,
-                     f"vtrials trial record: {name} ({head.kind}) — {s.head.title}",
-                     {"trial": name, "kind": head.kind, "ship": s.vessel.name, "scenario_file": s.path.name,
-                      "run_log": [a.log() for a in atts],
-                      "condition": {"displacement_m3": head.displacement_m3 or s.vessel.particulars.displacement,
-                                    "trim_m": head.trim_m},
-                      "tank_prediction": tank_prediction(s.vessel)},
-                     t_start=t0, settings=sorted(settings))
+        write_groups(path, groups, attrs)
         paths[name] = path
     return paths
+
+
+def trial_records_in_memory(res: AgendaResult) -> dict:
+    """{trial: Record} equal to what :func:`write_trial_records` then :func:`open_record` give — the
+    same arrays and attributes (:func:`vtrials.records.netcdf.record_in_memory`) — with no file written:
+    a campaign replicate reduces these."""
+    return {name: record_in_memory(Path("records") / f"{name}.nc", groups, attrs)
+            for name, (groups, attrs) in trial_record_contents(res).items()}
 
 
 def tank_prediction(vessel) -> dict:
@@ -303,9 +320,10 @@ def write_agenda_outputs(res: AgendaResult, out_dir: str | Path, plot: bool = Tr
         return _write_agenda_outputs(res, out, plot)
 
 
-def _score_sea_sensors(res: AgendaResult, paths: dict) -> dict:
+def _score_sea_sensors(res: AgendaResult, records: dict) -> dict:
     """Wave buoys and wave radars of each trial's record against the true sea (:mod:`vtrials.score.waves`);
-    {} when no instrument senses the sea (every shipped scenario: their results are unchanged)."""
+    {} when no instrument senses the sea (every shipped scenario: their results are unchanged).
+    ``records``: {trial: Record}."""
     kinds = {d.kind for d in res.crew.iset.devices.values()} if hasattr(res.crew, "iset") else set()
     if not kinds & {"wave_buoy", "wave_radar"}:
         return {}
@@ -313,28 +331,50 @@ def _score_sea_sensors(res: AgendaResult, paths: dict) -> dict:
     from vtrials.score.waves import score_wave_record
     field = wave_field(res.scenario)
     out = {}
-    for name, path in paths.items():
-        sc = score_wave_record(open_record(path), field)
+    for name, rec in records.items():
+        sc = score_wave_record(rec, field)
         if sc:
             out[name] = sc
     return out
 
 
-def _write_agenda_outputs(res: AgendaResult, out: Path, plot: bool) -> dict:
+def reduce_and_score(res: AgendaResult, records: dict) -> tuple[list, dict]:
+    """Reduce every trial's record (the reduction sees the Record only) and score it against the
+    truth: (trials list of results.json, wave-instrument scores). ``records``: {trial: Record}, read
+    from the files (:func:`write_agenda_outputs`) or built in memory (:func:`score_agenda`)."""
     from vtrials.reduce.trials import reduce_record
-    from vtrials.report.trial_report import write_report
     from vtrials.score.trials import score_trial
+    trials = []
+    for trial in res.scenario.agenda.trials:
+        name = trial.head.name
+        reduced = reduce_record(records[name])
+        scored = score_trial(trial.head.kind, reduced, res, name)
+        trials.append({"name": name, "kind": trial.head.kind, "record": f"records/{name}.nc", **scored})
+    return trials, _score_sea_sensors(res, records)
+
+
+def score_agenda(res: AgendaResult) -> dict:
+    """The campaign replicate's fast path: reduce and score from in-memory records
+    (:func:`trial_records_in_memory`), writing nothing — no truth.nc, records, results.json or report.
+    Returns ``{"trials": ..., "simulated_time_s": ...}`` with the trials list exactly as
+    :func:`write_agenda_outputs` puts it in results.json (same reduction code, same numbers)."""
+    t1 = time.perf_counter()
+    trials, waves = reduce_and_score(res, trial_records_in_memory(res))
+    res.timings.update({"reduce_score_s": time.perf_counter() - t1})
+    doc = {"simulated_time_s": res.simulated_time_s, "timings": res.timings, "trials": trials}
+    if waves:
+        doc["wave_instruments"] = waves
+    return json_clean(doc)
+
+
+def _write_agenda_outputs(res: AgendaResult, out: Path, plot: bool) -> dict:
+    from vtrials.report.trial_report import write_report
     t0 = time.perf_counter()
     write_agenda_truth(res, out / "truth.nc")
     paths = write_trial_records(res, out)
     t1 = time.perf_counter()
-    trials = []
-    for trial in res.scenario.agenda.trials:
-        name = trial.head.name
-        reduced = reduce_record(open_record(paths[name]))  # the reduction sees the record file only
-        scored = score_trial(trial.head.kind, reduced, res, name)
-        trials.append({"name": name, "kind": trial.head.kind, "record": f"records/{name}.nc", **scored})
-    waves = _score_sea_sensors(res, paths)
+    # the reduction sees the record files only
+    trials, waves = reduce_and_score(res, {name: open_record(p) for name, p in paths.items()})
     t2 = time.perf_counter()
     res.timings.update({"write_s": t1 - t0, "reduce_score_s": t2 - t1})
     crew = res.crew

@@ -101,7 +101,9 @@ def score_standardization(reduced: dict, res, name: str) -> dict:
     for r in reduced["runs"]:
         tr = truth[r["run"]]
         runs.append({"run": r["run"], "label": r["label"], "sog": _cmp(r["vg"], tr["sog"]),
-                     "power_measured": _cmp(r["power"], tr["power"]), "true_stw": tr["stw"],
+                     "power_measured": {**_cmp(r["power"], tr["power"], scale=tr["power"]),
+                                            "note": "error relative to the true power"},
+                     "true_stw": tr["stw"],
                      "true_current": [tr["current_n"], tr["current_e"]], "true_wind_speed": tr["wind_speed"]})
     calm = [_at_gauge(crew.iset, p, p["rps"]) for p in res.calm_water.get(name, [])]
     P_true, (vlo, vhi) = true_curve(calm) if len(calm) >= 2 else (None, (math.nan, math.nan))
