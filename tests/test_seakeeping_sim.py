@@ -47,18 +47,18 @@ def patrol():
     return ves, db, fit_radiation(db, dofs=(2, 3, 4))
 
 
-def _run(ves, db, model, omega, mu, speed, t_end):
+def _run(ves, db, model, omega, mu, speed, t_end, dt=DT):
     comp = np.array([[AMP, omega, omega ** 2 / db.g, math.cos(mu), math.sin(mu), 0.3]])
     start = ShipState(shaft_rps=(0.0,) * len(ves.shafts))
     if speed > 0.0:
-        calm = Simulator(ves, 1, DT)
+        calm = Simulator(ves, 1, dt)
         start = calm.self_propulsion(0, speed)
-    v2, _ = seakeeping_vessel(ves, db, comp, DT, model=model, excitation_dofs=(2, 3, 4))
-    sim = Simulator(v2, 1, DT)
+    v2, _ = seakeeping_vessel(ves, db, comp, dt, model=model, excitation_dofs=(2, 3, 4))
+    sim = Simulator(v2, 1, dt)
     sim.set_state(0, start)
     for k, n in enumerate(start.shaft_rps):
         sim.set_shaft_order(0, n, shaft=k)
-    sim.step(int(round(t_end / DT)))
+    sim.step(int(round(t_end / dt)))
     tr = sim.truth()[:, 0, :]
     return comp, {c: tr[:, sim.rec_names.index(c)] for c in ("t", "x", "y", "z", "roll", "pitch", "u")}
 
@@ -92,6 +92,35 @@ def test_head_seas_heave_pitch_match_rao(patrol, omega, speed):
         td = (c[0] + 1j * c[1]) / ce
         err = abs(td - fd[d]) / abs(fd[d])
         assert err <= 0.05, (omega, speed, col, td, fd[d], err)
+
+
+def _complex_response(r, comp, we, col):
+    """Complex amplitude of ``col`` per unit wave amplitude at the ship, over the last 6 periods."""
+    t = r["t"]
+    last = t > t[-1] - 6.0 * 2.0 * math.pi / we
+    basis = np.stack([np.cos(we * t[last]), -np.sin(we * t[last])], axis=1)
+    eta = np.array([elevation_at(comp, x, y, tt) for x, y, tt in zip(r["x"][last], r["y"][last], t[last])])
+    ce = np.linalg.lstsq(basis, eta, rcond=None)[0]
+    y = r[col][last]
+    c = np.linalg.lstsq(basis, y - y.mean(), rcond=None)[0]
+    return (c[0] + 1j * c[1]) / (ce[0] + 1j * ce[1])
+
+
+# The time step's own error: the same regular-wave response at dt 0.02 s and 0.01 s. The radiation
+# memory's state is advanced over the step just completed by that step's mean (secant) velocity before
+# its force is taken, so the memory is centred in time; when the force was taken before the advance, it
+# lagged the motion by a whole step and heave at ω = 2 rad/s led the RAO by 3.4° at dt 0.02 s and 2.0° at
+# 0.01 s (2.3 % complex difference between the two); now 0.74° and 0.72° (the radiation fit's own error).
+@pytest.mark.parametrize("col", ["z", "pitch"])
+def test_response_converges_in_the_time_step(patrol, col):
+    ves, db, model = patrol
+    omega = 2.0
+    out = []
+    for dt in (0.02, 0.01):
+        comp, r = _run(ves, db, model, omega, math.pi, 0.0, 80.0, dt=dt)
+        out.append(_complex_response(r, comp, omega, col))
+    diff = abs(out[0] - out[1]) / abs(out[1])
+    assert diff <= 0.004, (col, out, diff)
 
 
 def test_radiation_states_refuse_another_step(patrol):
