@@ -22,6 +22,14 @@ prediction errors; and the growth of the RMS errors from noise ×1 to ×2.
         --out benchmarks/results/campaign_identification_patrol51.json
     python benchmarks/campaign_identification.py --smoother --replicates 100 \
         --out benchmarks/results/campaign_identification_smoother.json     # states and covariance vs truth
+    python benchmarks/campaign_identification.py --replicates 100 --workers 3 --noise-scale 1 \
+        --out benchmarks/results/campaign_identification_bandwidth.json    # the regression's bandwidth study
+
+Every row also holds the regression's random σ of the linear derivatives at fixed Newey–West bandwidths
+(0–400 samples) and Andrews' (the rule before the study), so the summary's ``bandwidth_study`` gives the
+coverage and sharpness each bandwidth rule would have had on the same replicates. ``--refine oe`` adds
+the output-error refinement (about 20 s of CPU per replicate) on the first ``--oe-replicates``.
+The results file is rewritten every 5 replicates (``"partial": true`` until the end).
 """
 
 from __future__ import annotations
@@ -150,7 +158,7 @@ def _scenario(ship: str, seed: int, scale: int, where: Path) -> Path:
 
 
 def _replicate(args) -> dict:
-    ship, i, seed, scale, held, tmp = args
+    ship, i, seed, scale, held, tmp, refine = args
     import vtrials
     from vtrials.score.identification import score
     from vtrials.sysid.identify import identify_records
@@ -163,7 +171,8 @@ def _replicate(args) -> dict:
         if not held:   # held back from the replicate's own run
             held = [p for p in recs if p.stem in SHIPS[ship]["held_back"]]
         train = [p for p in recs if p not in held]
-        doc = identify_records(train, None, True, held, compare=(), with_contributions=False)
+        doc = identify_records(train, None, True, held, compare=(), with_contributions=False,
+                               refine=refine, diagnostics=True)
         sc = score(doc)
     finally:
         shutil.rmtree(work, ignore_errors=True)
@@ -172,7 +181,21 @@ def _replicate(args) -> dict:
     for k in SHIPS[ship]["linear"]:
         c, s = doc["coefficients"][k], sc["coefficients"][k]
         row["coefficients"][k] = {"value": c["value"], "lo95": c["lo95"], "hi95": c["hi95"], "truth": s["truth"],
-                                  "rel_error": s["rel_error"], "covered": s["covered"]}
+                                  "rel_error": s["rel_error"], "covered": s["covered"],
+                                  "std_random": c["std_random"], "std_systematic": c["std_systematic"],
+                                  "std_random_by_lags": doc["diagnostics"]["sigma_random"][k],
+                                  "std_random_andrews": doc["diagnostics"]["sigma_random_andrews"][k]}
+        if "output_error" in doc:
+            c, s = doc["output_error"]["coefficients"][k], sc["output_error"]["coefficients"][k]
+            row.setdefault("output_error", {})[k] = {
+                "value": c["value"], "lo95": c["lo95"], "hi95": c["hi95"], "truth": s["truth"],
+                "rel_error": s["rel_error"], "covered": s["covered"], "std_random": c["std_random"],
+                "std_systematic": c["std_systematic"]}
+    if "output_error" in doc:
+        row["output_error_fit"] = {k: doc["output_error"][k] for k in ("rms_weighted", "improved", "nfev", "lags")}
+    row["bandwidth"] = {eq: {key: d[key] for key in ("andrews_lags", "plateau_lags", "lag1") if key in d}
+                        | {"segment_mean": float(np.mean(d["segment_samples"]))}
+                        for eq, d in doc["diagnostics"].items() if eq in "XYNK"}
     return row
 
 
@@ -203,6 +226,42 @@ def _smoother(args) -> dict:
     return out
 
 
+def _bandwidth_study(rs, LINEAR) -> dict:
+    """Coverage and sharpness of the linear derivatives' 95 % intervals had the regression's random σ
+    come from a fixed Newey–West bandwidth (samples), or from the largest σ over the bandwidths up to
+    400 and Andrews' (the pipeline's rule since the study, :func:`vtrials.sysid.identify.random_sigma`),
+    or with the fixed-b widening at a fixed bandwidth; "andrews (before)": Andrews' AR(1) bandwidth alone
+    (the pipeline before the study); "reported": the intervals the rows hold (the code that ran them).
+    Each with the record-wide errors' σ added as in the pipeline."""
+    from vtrials.score.coverage import verdict
+    Z = 1.959963984540054
+    from vtrials.sysid.output_error import fixed_b_factor
+    lags = list(rs[0]["coefficients"][LINEAR[0]]["std_random_by_lags"])
+    out = {}
+    for rule in ["andrews (before)", "reported"] + lags + [f"{L}+fixed_b" for L in lags] + ["max over 0-400 and Andrews'"]:
+        per = {}
+        for k in LINEAR:
+            c = [r["coefficients"][k] for r in rs]
+            if rule.startswith("max over"):   # the pipeline's rule (vtrials.sysid.identify.random_sigma)
+                sr = np.array([max(max(x["std_random_by_lags"].values()), x["std_random_andrews"]) for x in c])
+            elif rule == "reported":
+                sr = np.array([x["std_random"] for x in c])
+            elif rule == "andrews (before)":
+                sr = np.array([x["std_random_andrews"] for x in c])
+            elif rule.endswith("+fixed_b"):
+                L = rule.split("+")[0]
+                sr = np.array([x["std_random_by_lags"][L] * fixed_b_factor(int(L) / r["bandwidth"][k[0]]["segment_mean"])
+                               for x, r in zip(c, rs)])
+            else:
+                sr = np.array([x["std_random_by_lags"][rule] for x in c])
+            sd = np.hypot(sr, [x["std_systematic"] for x in c])
+            err = np.array([x["value"] - x["truth"] for x in c])
+            v = verdict(list(np.abs(err) <= Z * sd), Z * sd, err)
+            per[k] = {key: v[key] for key in ("coverage", "wilson_lo", "wilson_hi", "sharpness", "verdict")}
+        out[rule] = per
+    return out
+
+
 def summarise(rows: list[dict]) -> dict:
     from vtrials.score.coverage import verdict
     LINEAR = tuple(rows[0]["coefficients"])
@@ -226,6 +285,25 @@ def summarise(rows: list[dict]) -> dict:
                     val = abs(e.get("rel_error", e.get("error_deg")))
                     worst[key] = max(worst.get(key, 0.0), val)
         out[f"noise_x{scale}"] = {"replicates": len(rs), "linear": per, "worst_prediction_error": worst}
+        oe_rows = [r for r in rs if "output_error" in r]
+        if oe_rows:
+            oe = {}
+            for k in LINEAR:
+                c = [r["output_error"][k] for r in oe_rows]
+                err = np.array([x["value"] - x["truth"] for x in c])
+                v = verdict([x["covered"] for x in c], np.array([(x["hi95"] - x["lo95"]) / 2 for x in c]), err)
+                rel = np.array([x["rel_error"] for x in c])
+                # the equation-error estimate on the same replicates, for comparison
+                rel_ee = np.array([r["coefficients"][k]["rel_error"] for r in oe_rows])
+                v.update(mean_rel_error=float(rel.mean()), rms_rel_error=float(np.sqrt(np.mean(rel**2))),
+                         max_abs_rel_error=float(np.abs(rel).max()),
+                         rms_rel_error_equation_error_same_replicates=float(np.sqrt(np.mean(rel_ee**2))))
+                oe[k] = v
+            out[f"noise_x{scale}"]["output_error"] = {
+                "replicates": len(oe_rows), "linear": oe,
+                "improved_fit": int(sum(r["output_error_fit"]["improved"] for r in oe_rows))}
+        if all("std_random_by_lags" in r["coefficients"][LINEAR[0]] for r in rs):
+            out[f"noise_x{scale}"]["bandwidth_study"] = _bandwidth_study(rs, LINEAR)
     if "noise_x1" in out and "noise_x2" in out:
         out["rms_growth_x2"] = {k: out["noise_x2"]["linear"][k]["rms_rel_error"]
                                 / out["noise_x1"]["linear"][k]["rms_rel_error"] for k in LINEAR}
@@ -239,10 +317,20 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=2016)
     ap.add_argument("--noise-scale", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--refine", choices=("none", "oe"), default="none",
+                    help="also the output-error (LM) refinement, scored beside the equation-error estimate")
+    ap.add_argument("--oe-replicates", type=int, default=10**9,
+                    help="output error on the first N replicates of the nominal suite only (it costs ~20 s each)")
     ap.add_argument("--smoother", action="store_true",
                     help="check the smoother's states and covariance against truth instead (no identification)")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "campaign_identification.json"))
+    ap.add_argument("--resummarise", metavar="JSON",
+                    help="recompute a results file's intervals by the pipeline's bandwidth rule from the σ its rows "
+                         "store (the first replicates of campaign_identification_bandwidth.json ran with a first cut "
+                         "that added the fixed-b widening) and its summary; rewritten in place")
     a = ap.parse_args(argv)
+    if a.resummarise:
+        return _resummarise(Path(a.resummarise))
     if a.smoother:
         return _smoother_campaign(a)
     import vtrials
@@ -255,18 +343,70 @@ def main(argv=None) -> int:
             d = Path(tmp) / scn.stem
             vtrials.run(str(scn), str(d), plot=False)
             held += [p for pat in cfg["held_back"] for p in sorted((d / "records").glob(f"{pat}.nc"))]
-        jobs = [(a.ship, i, s, scale, [str(h) for h in held], tmp) for scale in a.noise_scale for i, s in enumerate(seeds)]
+        jobs = [(a.ship, i, s, scale, [str(h) for h in held], tmp,
+                 "oe" if a.refine == "oe" and scale == 1 and i < a.oe_replicates else None)
+                for scale in a.noise_scale for i, s in enumerate(seeds)]
         rows = []
         with ProcessPoolExecutor(a.workers) as ex:
             for k, row in enumerate(ex.map(_replicate, jobs)):
                 rows.append(row)
-                if (k + 1) % 10 == 0:
+                if (k + 1) % 5 == 0:
                     print(f"{k + 1}/{len(jobs)} replicates, {time.perf_counter() - t0:.0f} s", flush=True)
+                    partial = {"ship": a.ship, "campaign_seed": a.seed, "replicates": a.replicates, "partial": True,
+                               "wall_s": time.perf_counter() - t0, "summary": summarise(rows), "rows": rows}
+                    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+                    Path(a.out).write_text(json.dumps(partial, indent=1))
     doc = {"ship": a.ship, "campaign_seed": a.seed, "replicates": a.replicates, "wall_s": time.perf_counter() - t0,
            "summary": summarise(rows), "rows": rows}
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps(doc, indent=1))
     print(json.dumps(doc["summary"], indent=1))
+    return 0
+
+
+def _projection(before: dict, rows: list) -> dict:
+    """The earlier 100-replicate campaign (same seeds, Andrews' bandwidth) with each interval widened by
+    the mean ratio of the new rule's σ to the old one over the replicates run here (paired: the same
+    seeds give the same estimates) — a projection, not a measurement."""
+    from vtrials.score.coverage import verdict
+    old = [r for r in before["rows"] if r["scale"] == 1]
+    out = {}
+    for k in rows[0]["coefficients"]:
+        c = [r["coefficients"][k] for r in rows]
+        ratio = np.array([np.hypot(x["std_random"], x["std_systematic"]) / np.hypot(x["std_random_andrews"],
+                                                                                  x["std_systematic"]) for x in c])
+        co = [r["coefficients"][k] for r in old]
+        err = np.array([x["value"] - x["truth"] for x in co])
+        half = np.array([(x["hi95"] - x["lo95"]) / 2 for x in co]) * ratio.mean()
+        v = verdict(list(np.abs(err) <= half), half, err)
+        out[k] = {"sigma_ratio_mean": float(ratio.mean()), "sigma_ratio_sd": float(ratio.std()), "replicates": len(co),
+                  **{key: v[key] for key in ("coverage", "wilson_lo", "wilson_hi", "sharpness", "verdict")}}
+    return out
+
+
+def _resummarise(path: Path) -> int:
+    """Each row's linear-derivative intervals by the pipeline's rule (vtrials.sysid.identify.random_sigma:
+    the largest Newey–West σ over the bandwidths 0–400 samples and Andrews', ⊕ the record-wide σ) from the
+    σ components the row stores — the same arithmetic as the pipeline — the row's original interval kept
+    as ``as_run``; then the summary."""
+    Z = 1.959963984540054
+    doc = json.loads(path.read_text())
+    for r in doc["rows"]:
+        for k, c in r["coefficients"].items():
+            if "std_random_by_lags" not in c:
+                continue
+            c.setdefault("as_run", {key: c[key] for key in ("lo95", "hi95", "covered", "std_random")})
+            sr = max(max(c["std_random_by_lags"].values()), c["std_random_andrews"])
+            sd = float(np.hypot(sr, c["std_systematic"]))
+            c.update(std_random=sr, lo95=c["value"] - Z * sd, hi95=c["value"] + Z * sd,
+                     covered=bool(abs(c["value"] - c["truth"]) <= Z * sd))
+    doc["summary"] = summarise(doc["rows"])
+    before = path.parent / "campaign_identification.json"
+    if before.is_file() and path.resolve() != before.resolve():
+        doc["summary"]["projection_over_the_earlier_100"] = _projection(json.loads(before.read_text()), doc["rows"])
+    doc["resummarised"] = "intervals by the pipeline's plateau rule from the stored σ (as_run: the first cut's)"
+    path.write_text(json.dumps(doc, indent=1))
+    print(json.dumps({k: v for k, v in doc["summary"].items()}, indent=1)[:3000])
     return 0
 
 

@@ -29,9 +29,37 @@ def test_check_env_passes(env_id):
 
 
 @pytest.mark.parametrize("kw", [dict(discrete=True), dict(engine_action=True, stack=3),
-                                dict(task="Stopping", discrete=True)])
+                                dict(task="Stopping", discrete=True),
+                                dict(task_options={"heading_integral": True}, stack=2)])
 def test_check_env_variants(kw):
     check_env(ShipEnv(**{"sea": "current", **kw}), skip_render_check=True)
+
+
+def test_course_keeping_heading_integral_observation():
+    """Option heading_integral: one more feature, the integral of the measured (gyro) heading error,
+    clipped at ±5°, over 10° L/U₀, recomputed here from the measured headings in ``info``; the other
+    features and the episode are those of the default environment (the option draws nothing)."""
+    opts = {"heading_integral": True, "course_change_deg": 3.0}
+    env_i = ShipEnv("CourseKeeping", "patrol51", sea="wind_current", task_options=opts)
+    env_d = ShipEnv("CourseKeeping", "patrol51", sea="wind_current", task_options={"course_change_deg": 3.0})
+    assert env_i.observation_space.shape == (env_d.observation_space.shape[0] + 1,)
+    a = np.array([0.15], dtype=np.float32)
+    oi, ri, _ = _episode(env_i, 5, 40, a)
+    od, rd, _ = _episode(env_d, 5, 40, a)
+    assert np.array_equal(oi[:, :-1], od) and np.array_equal(ri, rd)
+    core = env_i.core
+    ref, T, dt = core.task.ref[0], core.task.T[0], core.period
+    obs, info = env_i.reset(seed=5)
+    assert obs[-1] == 0.0
+    z, errs = 0.0, []
+    for _ in range(40):
+        obs, *_, info = env_i.step(a)
+        e = float(wrap(info["measured"]["heading"] - ref))
+        errs.append(e)
+        z += min(max(e, -5 * math.pi / 180), 5 * math.pi / 180) * dt
+        assert obs[-1] == pytest.approx(z / (10 * math.pi / 180 * T), rel=1e-5, abs=1e-7)
+    errs = np.abs(errs)
+    assert errs.min() < 5 * math.pi / 180 < errs.max()  # both the linear and the clipped part exercised
 
 
 def _episode(env, seed, n, action):

@@ -253,3 +253,36 @@ def test_slope_variance_of_correlated_fix_errors_matches_monte_carlo():
         v = slope_variance(t, comps)
         assert np.var(slopes) == pytest.approx(v, rel=0.08), (T, np.var(slopes), v)
         assert np.mean(ses) < 0.5 * v
+
+
+def test_standing_start_approach_speed_is_the_drift_through_the_water():
+    """A ship waiting with engines stopped drifts sideways in the wind (0.6 m/s abeam here): its speed
+    through the water at EXECUTE is that, as the references' sign(u)·|V| has it, not the ~0 of the
+    component along its course; the 90 % level of an acceleration from there rests on it."""
+    class Beam(Accel):
+        def y(self, t):
+            t = np.asarray(t, float)
+            return np.where(t < 0, 0.6 * t, 0.0)
+
+    run = Beam(u0=0.1, uT=8.0, k=0.05)  # 0.1 m/s ahead, 0.6 m/s abeam
+    t, N, E = fixes(run, 400.0, np.random.default_rng(5), sig=0.5)
+    r = R.reach_analysis(t, N, E, 0.0, heading=np.full(t.size, run.psi0), n_boot=0)
+    assert r.approach_speed.value == pytest.approx(math.hypot(0.1, 0.6), abs=0.03)
+
+
+def test_velocity_crossing_unbiased_at_the_knee():
+    """Time to 90 % of an acceleration found on a measured speed series (GNSS Doppler: white noise
+    0.05 m/s at 1 Hz): a hard acceleration u = U_T − (U_T − U_0)e^{−kt}, k = 0.1 s⁻¹ (0.8 m/s² at
+    the start). Over 300 noisy series the crossing is unbiased (< 0.02 s) and its SE matches the
+    scatter within 15 %."""
+    rng = np.random.default_rng(2)
+    u0, uT, k = 0.0, 8.0, 0.1
+    t = np.arange(-30.0, 120.0, 1.0) + 0.37
+    U = np.where(t < 0, u0, uT - (uT - u0) * np.exp(-k * np.clip(t, 0, None)))
+    level = u0 + 0.9 * (uT - u0)
+    exact = math.log(10) / k
+    out = np.array([R.velocity_crossing(t, U + rng.normal(0, 0.05, t.size), level, 1.0, 0.0)
+                    for _ in range(300)])
+    err = out[:, 0] - exact
+    assert abs(err.mean()) < 0.02
+    assert np.mean(out[:, 1]) == pytest.approx(err.std(ddof=1), rel=0.15)

@@ -377,3 +377,91 @@ def test_approach_speed_from_a_given_current_not_the_drift():
     assert res_c.approach_speed.value == pytest.approx(turn.U0, abs=1e-6)
     assert res_d.approach_speed.value - res_c.approach_speed.value == pytest.approx(-float(lee @ u), abs=1e-9)
     assert res_c.approach_speed.std >= math.sqrt(float(u @ cov @ u))
+
+
+# ------------------------------------------------------------------ steady loop (360° → 720°)
+def _loop_turn(rng, R=150.0, U=5.0, wobble=0.1, ground_drift=(0.1, 0.25), side=1, t_end=480.0,
+               sig_p=0.5, sig_h=0.001):
+    """Approach at U on course ψ₀ for 60 s, then at EXECUTE (t = 0) an instant steady circle of
+    radius R in a frame drifting at ``ground_drift`` (current + the circle's own leeway), the rate of
+    change of heading r₀(1 + wobble·sin ψ) (the wind's push varies around the loop). Fixes at 1 Hz
+    (σ_p), gyro at 10 Hz (σ_h). Returns the records and the analytic loop: heading change of 360°
+    from EXECUTE at t₁ = T, 720° at 2T, T = 2π/(r₀√(1 − wobble²))."""
+    r0 = U / R
+    psi0 = 0.4
+    dt = 0.01
+    tt = np.arange(0.0, t_end, dt)
+    psi = np.empty_like(tt)
+    psi[0] = psi0
+    for k in range(1, tt.size):
+        half = psi[k - 1] + 0.5 * dt * side * r0 * (1 + wobble * math.sin(psi[k - 1]))
+        psi[k] = psi[k - 1] + dt * side * r0 * (1 + wobble * math.sin(half))
+    ang = psi - side * math.pi / 2
+    cN, cE = -R * math.cos(psi0 - side * math.pi / 2), -R * math.sin(psi0 - side * math.pi / 2)
+    N_t = cN + R * np.cos(ang) + ground_drift[0] * tt
+    E_t = cE + R * np.sin(ang) + ground_drift[1] * tt
+    # the approach: straight on ψ₀ at U plus the drift, joining the circle at EXECUTE (origin)
+    ta = np.arange(-60.0, 0.0, dt)
+    N_a = U * math.cos(psi0) * ta + ground_drift[0] * ta
+    E_a = U * math.sin(psi0) * ta + ground_drift[1] * ta
+    t_all = np.concatenate([ta, tt])
+    N_all, E_all, psi_all = np.concatenate([N_a, N_t]), np.concatenate([E_a, E_t]), np.concatenate([np.full(ta.size, psi0), psi])
+    tp = np.arange(-60.0, t_end - 1.0, 1.0) + 0.25
+    th = np.arange(-60.0, t_end - 1.0, 0.1) + 0.05
+    N = np.interp(tp, t_all, N_all) + rng.normal(0, sig_p, tp.size)
+    E = np.interp(tp, t_all, E_all) + rng.normal(0, sig_p, tp.size)
+    h = np.interp(th, t_all, psi_all) + rng.normal(0, sig_h, th.size)
+    T = 2 * math.pi / (r0 * math.sqrt(1 - wobble ** 2))
+    return tp, N, E, th, h, T
+
+
+@pytest.mark.parametrize("side", [1, -1])
+def test_steady_loop_diameter_rate_and_speed(side):
+    """Steady values over the second loop, the track closed by the circle's own drift: diameter 2R,
+    rate 2π/T (the mean rate over the loop), speed R·2π/T, each within its interval; the loop's end
+    times are the analytic 360° and 720° instants. Correcting the loop with a drift that differs from
+    its own by 0.1 m/s (the day's mean of both sides) moves the diameter by metres."""
+    rng = np.random.default_rng(7 if side > 0 else 8)
+    R, drift = 150.0, (0.1, 0.25)
+    tp, N, E, th, h, Tl = _loop_turn(rng, R=R, ground_drift=drift, side=side)
+    t_finex = 2 * Tl + 20.0
+    loop = T.steady_loop(th, h, 0.0, t_finex)
+    assert loop.full
+    assert loop.t_start == pytest.approx(Tl, abs=0.05)
+    assert loop.t_end == pytest.approx(2 * Tl, abs=0.05)
+    own = (Estimate(drift[0], 0.002), Estimate(drift[1], 0.002))
+    res = T.turning_metrics(tp, N, E, h, 0.0, t_heading=th, drift=own, loop_drift=own, t_finex=t_finex)
+    rate = 2 * math.pi / Tl
+    assert res.steady_diameter.covers(2 * R, 0.99)
+    assert abs(res.steady_diameter.value - 2 * R) < 0.5
+    assert res.steady_rate.covers(side * rate, 0.99)
+    assert abs(res.steady_rate.value - side * rate) < 2e-4 * rate
+    assert res.steady_speed.covers(R * rate, 0.99)
+    other = (drift[0] - 0.1, drift[1])
+    off = T.turning_metrics(tp, N, E, h, 0.0, t_heading=th, drift=own, loop_drift=other, t_finex=t_finex)
+    assert abs(off.steady_diameter.value - 2 * R) > 1.0
+
+
+def test_circle_radius_variance_from_correlated_errors_matches_monte_carlo():
+    """The radius of a circle fitted to one loop under Gauss–Markov tracking errors (sd 1 m, τ 120 s,
+    and 0.5 m, 10 s, per axis: a DGPS's wander and multipath) scatters as the linear propagation
+    (:func:`vtrials.reduce.series.correlated_variance` through the fit's radius weights) says."""
+    from vtrials.reduce.series import correlated_variance
+    rng = np.random.default_rng(3)
+    R, Tl = 150.0, 190.0
+    t = np.arange(0.0, Tl, 1.0)
+    a = 2 * math.pi * t / Tl
+    x, y = R * np.cos(a), R * np.sin(a)
+    comps = [(1.0, 120.0), (0.5, 10.0)]
+    p, _, _ = T.fit_circle(x, y)
+    h, ph = T._circle_radius_weights(x, y, p)
+    sd_pred = math.sqrt(correlated_variance(t, h, comps, ph))
+    dt = np.abs(t[:, None] - t[None, :])
+    L = np.linalg.cholesky(sum(sd ** 2 * np.exp(-dt / tau) for sd, tau in comps) + 1e-9 * np.eye(t.size))
+    Rs = []
+    for _ in range(600):
+        ex, ey = L @ rng.normal(size=t.size), L @ rng.normal(size=t.size)
+        Rs.append(T.fit_circle(x + ex, y + ey)[0][2])
+    sd_mc = float(np.std(Rs, ddof=1))
+    assert sd_pred == pytest.approx(sd_mc, rel=0.12)
+    assert sd_pred > 0.2  # far above the white-noise-only value a residual-based SE would give

@@ -25,7 +25,7 @@ STAGES = ["base", "physics", "truth", "instruments", "records", "trials", "reduc
 STAGE_OF = {"errors": "base", "units": "base", "schema": "base", "physics": "physics", "truth": "truth",
             "instruments": "instruments", "records": "records", "trials": "trials", "reduce": "reduce",
             "score": "score", "report": "report", "scenario": "app", "runner": "app", "cli": "app",
-            "campaign": "app", "envs": "app", "sysid": "app", "__main__": "app", "": "app"}
+            "campaign": "app", "plan": "app", "envs": "app", "sysid": "app", "__main__": "app", "": "app"}
 # what a reduction may use from vtrials: its own package, the record reader, the base modules
 ALLOWED_IN_REDUCE = {"vtrials.reduce", "vtrials.records", "vtrials.units", "vtrials.errors"}
 ALLOWED_EXTERNAL = {"numpy", "scipy", "math", "dataclasses", "typing", "__future__", "json", "collections",

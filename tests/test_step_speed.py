@@ -5,7 +5,8 @@
   terms' magnitudes; a misplaced coefficient is off by orders of magnitude more);
 * ``Simulator.step(n)`` (runs of steps in one compiled call, the batch stepped through a hook)
   against the plain loop it replaces (one kernel call and one ``Batch.step`` per step from Python):
-  truth rows, states and the stop at a runaway, bit for bit;
+  truth rows, states and the stop at a runaway, bit for bit; a failure of the batch's step (reached
+  without its Python wrapper) still stops with MuJoCo's message;
 * ``Simulator.kinematics()`` against the context a full force evaluation writes;
 * the heading fold of the wave tables against its definition (β = μ − ψ wrapped, mirror for β < 0).
 """
@@ -135,6 +136,32 @@ def test_runaway_stops_at_the_same_step_with_the_same_rows():
     (m1, c1, t1, q1), (m2, c2, t2, q2) = out
     assert "speed beyond the runaway limit" in m1 and 0 < c1 < 100000
     assert m1 == m2 and c1 == c2 and np.array_equal(t1, t2) and np.array_equal(q1, q2)
+
+
+class _FailingBatch:
+    """In place of a Batch's compiled core: every step fails in simulation 1 (as MuJoCo reports it)."""
+
+    nsim = 2
+
+    def step(self, ids, nstep, stage):
+        return 1
+
+    def error(self, sim):
+        return f"simulated MuJoCo error in {sim}"
+
+
+def test_batch_failure_through_the_hook_stops_with_mujocos_message():
+    """The hook steps the batch's core directly; a failed simulation still raises MuJoCo's
+    SimulationError through the batch's own check, and the simulator stops with its message."""
+    sim = _sim("patrol51", 2, 0.02)
+    sim.step(3)
+    sim.batch._b = _FailingBatch()
+    sim.batch.status = np.array([0, 1], dtype=np.int32)
+    with pytest.raises(SimulationError) as e:
+        sim.step(5)
+    msg = str(e.value)
+    assert "(ship 1)" in msg and "simulated MuJoCo error in 1" in msg and "MuJoCo raised in 1 of 2" in msg
+    assert sim._step_count == 3 and sim._hook_error is None
 
 
 def test_kinematics_equals_the_evaluated_context():

@@ -69,3 +69,47 @@ def test_zigzag_metrics_on_known_heading():
         assert m["first_overshoot_time_s"] == pytest.approx(15.0, abs=1e-3)
         assert m["time_to_check_yaw_s"] == pytest.approx(15.0 - t1, abs=1e-3)
         assert m["period_s"] == pytest.approx(60.0, abs=1e-3)
+
+
+def _drifting_turn(R=150.0, U=5.0, leeway=(0.12, -0.05), wobble=0.0, side=1, dt=0.05, t_end=500.0):
+    """A steady circle (radius R through a frame that drifts at ``leeway`` [m/s]) entered at t = 0,
+    rate of change of heading r₀(1 + wobble·sin ψ) (the wind's heading-dependent push), positions in
+    the water frame = circle + leeway·t."""
+    r0 = U / R
+    t = np.arange(0.0, t_end, dt)
+    psi = np.empty_like(t)
+    psi[0] = 0.3
+    for k in range(1, t.size):  # midpoint integration of ψ̇ = r₀(1 + w sin ψ)
+        half = psi[k - 1] + 0.5 * dt * side * r0 * (1 + wobble * math.sin(psi[k - 1]))
+        psi[k] = psi[k - 1] + dt * side * r0 * (1 + wobble * math.sin(half))
+    # along the circle the arc speed is R·|ψ̇| in the drifting frame
+    ang = psi - side * math.pi / 2
+    x = R * np.cos(ang) + leeway[0] * t
+    y = R * np.sin(ang) + leeway[1] * t
+    rate = np.gradient(psi, t)
+    u = R * np.abs(rate)
+    return t, x, y, psi, u, np.zeros_like(t), rate
+
+
+def test_steady_circle_is_closed_by_its_own_loop_drift():
+    """A circle drifting with the wind's leeway of the circling ship: the steady turning diameter is
+    that of the circle in the frame drifting with it (ITTC 7.5-04-02-01 removes the drift loop by loop).
+    A circle fitted to the open loop is off by up to drift·T/(2π) in radius, by where the loop starts
+    (old definition: 294.2 m instead of 300 m here)."""
+    R = 150.0
+    t, x, y, psi, u, v, r = _drifting_turn(R=R, leeway=(0.12, -0.05))
+    m = TM.turning(t, x, y, psi, u, v, r)
+    assert m["steady_turning_diameter_m"] == pytest.approx(2 * R, abs=0.01)
+    assert m["steady_loop_drift_mps"] == pytest.approx([0.12, -0.05], abs=1e-4)
+
+
+@pytest.mark.parametrize("side", [1, -1])
+def test_steady_rate_is_the_mean_rate_over_the_loop(side):
+    """Rate varying around the loop (ψ̇ = r₀(1 + 0.1 sin ψ)): the steady rate of turn is the heading
+    change over the loop / its duration, 2π/T with T = ∫dψ/ψ̇ = 2π/(r₀√(1 − 0.1²)); an OLS slope over
+    the loop depends on the loop's starting heading (old definition: off by 1.1 % here)."""
+    R, U, w = 150.0, 5.0, 0.1
+    t, x, y, psi, u, v, r = _drifting_turn(R=R, U=U, leeway=(0.0, 0.0), wobble=w, side=side, dt=0.02)
+    m = TM.turning(t, x, y, psi, u, v, r)
+    expected = (U / R) * math.sqrt(1 - w * w)
+    assert math.radians(m["steady_rate_of_turn_dps"]) == pytest.approx(expected, rel=1e-4)

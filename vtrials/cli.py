@@ -63,6 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  inspect  list a trial record's channels, rates and units; plot chosen channels\n"
                "  campaign run many randomized replicates of an agenda; coverage and sharpness of every interval\n"
                "  render   render a run's truth as a video (MuJoCo, offscreen)\n"
+               "  plan     the cheapest agenda predicted to meet an accuracy target at a site, verified by campaigns\n"
                "  identify identify the hull's maneuvering coefficients from maneuver records; predict held-back maneuvers\n"
                "  models   list the vessel models\n\nSee 'vtrials run --help' for the scenario format.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -109,6 +110,27 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--resume", action="store_true", help="continue a campaign killed before it finished")
     c.add_argument("--records", action="store_true", help="keep every replicate's records and truth")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
+    pl = sub.add_parser("plan", help="the cheapest trial agenda predicted to meet an accuracy target",
+                        description="Search a family of candidate agendas (spots, runs per spot, run length), "
+                                    "cheapest first, by campaigns at the plan's site climate; choose the cheapest "
+                                    "predicted to meet the target; verify it and the agenda one step cheaper by "
+                                    "larger campaigns. Writes plan.json, plan.md and the campaigns to DIR.",
+                        epilog="Plan file (TOML): [plan] kind, scenario, seed, search_replicates, verify_replicates; "
+                               "[site] water_depth_m; [climate] 'dotted.path' = { uniform | normal | choice } or a "
+                               "value; [target] quantity (speed | power), rpm/pitch or order, tolerance, "
+                               "confidence, rule (quantile | wilson); [limits] max_hours, max_wind_kn; "
+                               "[candidates] spots, runs, run_s, neighbours, turn_s, setting_change_s. "
+                               "See vtrials/plan/spec.py and scenarios/plans/plan_patrol51_standardization.toml.")
+    pl.add_argument("plan", metavar="PLAN", help="plan file (TOML)")
+    pl.add_argument("--out", metavar="DIR", required=True, help="output directory (an unfinished plan there resumes)")
+    pl.add_argument("--replicates", type=int, metavar="N", help="replicates per search campaign (default: the plan's)")
+    pl.add_argument("--verify-replicates", type=int, metavar="M",
+                    help="replicates of each verifying campaign (default: the plan's)")
+    pl.add_argument("--workers", type=int, default=1, metavar="W", help="worker processes per campaign (default 1)")
+    pl.add_argument("--assemble", action="store_true",
+                    help="run nothing: decide and report from the campaigns already in DIR (verifying campaigns "
+                         "stopped short are summarized over the replicates they have)")
+    pl.add_argument("--quiet", action="store_true", help="print nothing but errors")
     ren = sub.add_parser("render", help="render a run's truth as a video",
                          description="Render the ship of RUN_DIR/truth.nc in its sea with its wake (MuJoCo, "
                                      "offscreen: MUJOCO_GL=egl or osmesa where there is no display).")
@@ -134,6 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="records of maneuvers to predict (not fitted): turning circles and zig-zags")
     idf.add_argument("--all-terms", action="store_true",
                      help="predict with every term of the structure (default: the stepwise-selected terms)")
+    idf.add_argument("--refine", choices=("none", "oe"), default="none",
+                     help="oe: also refine the equation-error coefficients by output error (Levenberg–Marquardt fit "
+                          "of the model's simulated u, v, r, heading to the smoothed ones; MMG model), reported beside them")
     idf.add_argument("--no-score", action="store_true", help="reduce only; do not compare with the truth")
     return p
 
@@ -143,7 +168,7 @@ def _identify(args) -> int:
     from vtrials.runner.staging import check_out, staged_output
     from vtrials.sysid.identify import identify_records
     check_out(args.out)
-    doc = identify_records(args.records, args.model, not args.all_terms, args.held_back)
+    doc = identify_records(args.records, args.model, not args.all_terms, args.held_back, refine=args.refine)
     if not args.no_score:
         from vtrials.score.identification import score
         doc["score"] = score(doc)
@@ -160,6 +185,16 @@ def _identify(args) -> int:
             sc = doc.get("score", {}).get("coefficients", {}).get(k)
             tail = f"   truth {sc['truth']:+.5g} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
             print(f"  {k:<5} {c['value']:+.5g}  95 % [{c['lo95']:+.5g}, {c['hi95']:+.5g}]{tail}")
+    if "output_error" in doc:
+        o = doc["output_error"]
+        print(f"  output error (LM, {o['nfev']} evaluations): weighted RMS {o['rms_weighted']['start']:.3f} → "
+              f"{o['rms_weighted']['refined']:.3f}")
+        for k in doc["intervals_checked"]:
+            c = o["coefficients"].get(k)
+            if c:
+                sc = doc.get("score", {}).get("output_error", {}).get("coefficients", {}).get(k)
+                tail = f"   truth {sc['truth']:+.5g} ({100 * sc['rel_error']:+.1f} %)" if sc else ""
+                print(f"  {k:<5} {c['value']:+.5g}  95 % [{c['lo95']:+.5g}, {c['hi95']:+.5g}]{tail}  (output error)")
     for p in doc["predictions"]:
         print(f"  predicted {p['name']}: " + ", ".join(f"{k} {v:.3g}" for k, v in p["predicted"].items()))
     if "score" in doc:
@@ -194,6 +229,22 @@ def _campaign(args) -> int:
             print(f"{q['group']:<56} {q['n']:>5} {q['coverage']:>9.3f} "
                   f"[{q['wilson_lo']:.3f}, {q['wilson_hi']:.3f}] {q['sharpness']:>9.2f}  {q['verdict']}")
         print(f"wrote {args.out}/campaign.parquet, summary.parquet, summary.json")
+    return 0
+
+
+def _plan(args) -> int:
+    from vtrials.plan import plan
+    for name, v, lo in (("--replicates", args.replicates, 3), ("--verify-replicates", args.verify_replicates, 3),
+                        ("--workers", args.workers, 1)):
+        if v is not None and v < lo:
+            raise InputError(name, "", f"must be at least {lo}")
+    say = None if args.quiet else (lambda line: print(line, flush=True))
+    doc = plan(args.plan, args.out, workers=args.workers, say=say, search_replicates=args.replicates,
+               verify_replicates=args.verify_replicates, assemble=args.assemble)
+    if not args.quiet:
+        from pathlib import Path
+        print(Path(args.out, "plan.md").read_text())
+        print(f"wrote {args.out}/plan.json, plan.md")
     return 0
 
 
@@ -325,6 +376,8 @@ def main(argv: list[str] | None = None) -> int:
             return _campaign(args)
         if args.command == "identify":
             return _identify(args)
+        if args.command == "plan":
+            return _plan(args)
         if args.command == "render":
             from vtrials.envs.video import render_run
             if args.fps < 1:

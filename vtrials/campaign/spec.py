@@ -84,12 +84,18 @@ def load_campaign(path: str) -> CampaignSpec:
         raise InputError(f, "campaign.replicates", f"{reps!r}: expected an integer ≥ 1")
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise InputError(f, "campaign.seed", f"{seed!r}: expected an integer ≥ 0")
+    vary = parse_vary(camp.get("vary", {}), doc, f, "campaign.vary")
+    return CampaignSpec(f, doc, tuple(vary), reps, seed)
+
+
+def parse_vary(table, doc: dict, f: str, where0: str) -> list[Vary]:
+    """The draws of a ``{ "dotted.path" = { distribution } }`` table, each checked against ``doc``
+    (errors name file ``f`` and field ``where0.<path>``)."""
     vary = []
-    table = camp.get("vary", {})
     if not isinstance(table, dict):
-        raise InputError(f, "campaign.vary", "expected a table of 'dotted.path' = { distribution }")
+        raise InputError(f, where0, "expected a table of 'dotted.path' = { distribution }")
     for key, d in table.items():
-        where = f"campaign.vary.{key}"
+        where = f"{where0}.{key}"
         if not _PATH.match(key):
             raise InputError(f, where, "not a dotted field path (e.g. \"environment.wind.speed_kn\")")
         if not isinstance(d, dict):
@@ -114,7 +120,7 @@ def load_campaign(path: str) -> CampaignSpec:
                 raise InputError(f, f"{where}.{b}", "expected a finite number")
         _locate(doc, key, f, where)  # the field must exist or its table must
         vary.append(Vary(key, kind, tuple(args), d.get("min"), d.get("max")))
-    return CampaignSpec(f, doc, tuple(vary), reps, seed)
+    return vary
 
 
 def _locate(doc: dict, path: str, f: str, where: str):

@@ -111,6 +111,7 @@ class ShipBatch:
         period = control_period_s if control_period_s is not None else self.L / U_full / 12.0
         self.substeps = max(1, int(round(period / self.dt)))
         self.period = self.substeps * self.dt
+        self.task.period = self.period
         # horizon of the observation noise: the longest episode (the slowest approach order)
         U_min = min(self._steady_state(o).u for o in self.task.orders)
         self.max_steps = int(math.ceil(self.task.duration_LU * self.L / U_min / self.period))

@@ -5,6 +5,10 @@ Lengths are scaled by the ship length L, times by L/U₀ (U₀ the approach spee
 definition fits KVLCC2 and patrol51 alike.
 
 * CourseKeeping — hold a commanded heading ψ_ref: reward −(e/10°)² (clipped at −10) − 0.01 (δ/δ_max)².
+  Option ``heading_integral`` (default off): one more feature, the time integral of the MEASURED
+  heading error z = Σ clip(e_m, ±5°) Δt since the episode began, over (10° · L/U₀) — the controller
+  state an autopilot's integral action keeps (instruments only), so that a policy can learn to hold
+  the gyro heading with no steady offset. The clip bounds the wind-up during the course change.
 * ZigZag — execute a δ_z/ψ_z zig-zag precisely (ITTC 7.5-04-02-01 / IMO MSC.137(76) procedure): the
   rudder order must follow the ideal order s·δ_z, where the ideal switching s flips when the TRUE heading
   change passes ±ψ_z; reward −((δ_o − s δ_z)/δ_z)²; ends after the 4th rudder reversal.
@@ -79,18 +83,34 @@ class CourseKeeping(Task):
     duration_LU = 40.0
     n_features = 3
 
+    INTEGRAL_CLIP = 5 * DEG  # error clip of the heading-error integral (bounds the wind-up in a course change)
+
     def __init__(self, n, L, delta_max, options=None):
         super().__init__(n, L, delta_max, options)
         self.ref = np.zeros(n)
+        self.integral = bool(self.opt.get("heading_integral", False))
+        self.n_features = 4 if self.integral else 3
+        self.period = 1.0  # control period [s]: set by the environment
+        self.z = np.zeros(n)  # integral of the measured heading error [rad s]
+        self.fresh = np.ones(n, dtype=bool)
 
     def begin(self, i, U0, rng):
         super().begin(i, U0, rng)
         step = float(self.opt.get("course_change_deg", 15.0)) * DEG
         self.ref[i] = self.psi0[i] + rng.uniform(-step, step)
+        self.z[i] = 0.0
+        self.fresh[i] = True
 
     def features(self, meas, idx):
         e = wrap(meas[:, 0] - self.ref[idx])
-        return np.column_stack([e / (10 * DEG), np.sin(self.ref[idx]), np.cos(self.ref[idx])])
+        f = [e / (10 * DEG), np.sin(self.ref[idx]), np.cos(self.ref[idx])]
+        if self.integral:
+            # first sample of an episode: nothing integrated yet
+            self.z[idx] += np.where(self.fresh[idx], 0.0,
+                                    np.clip(e, -self.INTEGRAL_CLIP, self.INTEGRAL_CLIP) * self.period)
+            self.fresh[idx] = False
+            f.append(self.z[idx] / (10 * DEG * self.T[idx]))
+        return np.column_stack(f)
 
     def score(self, truth, rud_order):
         e = wrap(truth["psi"] - self.ref)

@@ -389,6 +389,43 @@ def ittc_iterative(t, vg, heading, power, q=None, model="tidal", period=TIDAL_PE
         rss_history=tuple(rss_hist), dof=dof)
 
 
+def iterative_spot_speed(res: IterativeResult, t, heading, idx, vg_std=None) -> Estimate:
+    """Speed through water of one spot from an all-runs ITTC iterative analysis (:func:`ittc_iterative`).
+
+    t, heading: the mid-times [s] and headings [rad] of ALL the runs given to the analysis (in its
+    order); idx: indices of the spot's runs among them. Value: the heading-balanced mean
+    ½(mean V_S over the spot's runs on its first run's course + mean over the reciprocal runs), the
+    quantity a mean of means estimates, so the two methods are compared on one definition.
+
+    Std: the spot's runs share the fitted current, so their V_S errors are correlated; with weights wᵢ
+    and sᵢ = cos(φᵢ − φ₀) (φ₀ the analysis' reference course) the current part is
+    σ² = (w s)ᵀ B Σ_c B ᵀ(w s) (B the current model's basis at the runs, Σ_c its parameter covariance),
+    plus Σ wᵢ² vg_stdᵢ² when vg_std is given. Which current model was fitted (and whether it is right)
+    is the caller's question: a current that departs from the model's shape leaves an error this std
+    does not contain.
+    """
+    t = np.asarray(t, dtype=float)
+    ph = np.asarray(heading, dtype=float)
+    idx = np.asarray(idx, dtype=int)
+    if idx.size < 2:
+        raise ValueError("a spot needs at least two runs (a double run)")
+    s_spot = np.cos(ph[idx] - ph[idx[0]])
+    base, recip = s_spot > 0, s_spot <= 0
+    if not base.any() or not recip.any():
+        raise ValueError("a spot needs runs on both its course and the reciprocal")
+    w = np.where(base, 0.5 / base.sum(), 0.5 / recip.sum())
+    value = float(np.dot(w, np.asarray(res.vs)[idx]))
+    B = _current_basis(t[idx] - res.t_ref, res.model, res.period)
+    k = len(_MODELS[res.model])
+    cc = res.cov[-k:, -k:]
+    g = (w * np.cos(ph[idx] - ph[0])) @ B
+    var = float(g @ cc @ g)
+    if vg_std is not None:
+        var += float(np.sum((w * _std_array(vg_std, t.size)[idx]) ** 2))
+    std = math.sqrt(var) if np.isfinite(var) and var >= 0 else math.nan
+    return Estimate(value, std, res.a.dof)
+
+
 # ==================================================================================================
 # four-leg resolution (seed 000, Appendix A) and its generalisations
 # ==================================================================================================

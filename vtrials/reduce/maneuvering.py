@@ -111,6 +111,22 @@ class Channels:
             dn, de = _horizontal_offset(self.lever_arm, phi, th, psi)
             self.north = self.north - dn
             self.east = self.east - de
+        # the receiver's own velocity over ground (GNSS Doppler: sog, cog), moved like the fixes to
+        # the reference point (less the rate of change of the lever arm's horizontal offset)
+        self.velocity = None
+        if tm.get("kind") == "gnss" and "sog" in rec.channels(self.tracking) and self.heading is not None:
+            tv, sog = rec.channel(self.tracking, "sog")
+            _, cog = rec.channel(self.tracking, "cog")
+            okv = np.isfinite(sog) & np.isfinite(cog)
+            tv = tv[okv] - lag
+            vn, ve = sog[okv] * np.cos(cog[okv]), sog[okv] * np.sin(cog[okv])
+            if tv.size >= 20 and np.any(self.lever_arm != 0.0):
+                psi = np.interp(tv, self.t_heading, self.heading)
+                phi = np.interp(tv, self.t_roll, self.roll) if self.roll is not None else 0.0 * psi
+                th = np.interp(tv, self.t_pitch, self.pitch) if self.pitch is not None else 0.0 * psi
+                dn, de = _horizontal_offset(self.lever_arm, phi, th, psi)
+                vn, ve = vn - np.gradient(dn, tv), ve - np.gradient(de, tv)
+            self.velocity = (tv, vn, ve) if tv.size >= 20 else None
         rud = k.get("rudder", [])
         # the synchros' calibration uncertainty, common to every reading (of the mean of n synchros)
         cal = [float(rec.meta(r).get("calibration_uncertainty_rad", 0.0)) for r in rud]
@@ -429,7 +445,8 @@ def reduce_maneuvering(rec: Record) -> dict:
                                      t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
                                      rudder=w.get("rudder"), t_rudder=w.get("t_rudder"), approach_s=approach,
                                      steady=sw, current=current_at(r["t_execute"]), roll_bias=ch.roll_bias,
-                                     fix_errors=ch.fix_errors, timing_sd=ch.timing_sd(r["t_execute"]))
+                                     fix_errors=ch.fix_errors, timing_sd=ch.timing_sd(r["t_execute"]),
+                                     t_finex=r["t_finex"], gyro_drift=ch.gyro_drift)
         except (ValueError, np.linalg.LinAlgError) as exc:
             out_runs.append({"run": r["run"], "type": "turn", "error": str(exc)})
             continue
@@ -461,7 +478,8 @@ def reduce_maneuvering(rec: Record) -> dict:
                                          approach_s=r["t_execute"] - r["t_comex"], steady=res0.steady, drift=(dn, de),
                                          sigma_fix=ch.sigma_fix, current=current_at(r["t_execute"]),
                                          roll_bias=ch.roll_bias, fix_errors=ch.fix_errors,
-                                         timing_sd=ch.timing_sd(r["t_execute"]))
+                                         timing_sd=ch.timing_sd(r["t_execute"]), t_finex=r["t_finex"],
+                                         gyro_drift=ch.gyro_drift, loop_drift=res0.drift)
             except (ValueError, np.linalg.LinAlgError):
                 continue
             own = d.get("drift")
@@ -494,7 +512,7 @@ def reduce_maneuvering(rec: Record) -> dict:
                 res = RE.reach_analysis(w["t"], w["north"], w["east"], r["t_execute"], heading=w["heading"],
                                         t_heading=w["t_heading"], drift=drift, approach_s=approach,
                                         seed=int(r["run"]), fix_errors=ch.fix_errors,
-                                        timing_sd=ch.timing_sd(r["t_execute"]))
+                                        timing_sd=ch.timing_sd(r["t_execute"]), velocity=ch.velocity)
                 d.update(_clean(res.to_dict()))
                 cv = res.curve
                 if cv:

@@ -65,6 +65,26 @@ def ar1_inflation(resid) -> float:
     return math.sqrt((1 + rho) / (1 - rho))
 
 
+def correlated_variance(t, w, components, phase=None) -> float:
+    """Variance of the linear combination Σ w_i e_i of errors e_i at times ``t`` [s] that are
+    correlated in time: ``components`` (sd, τ) pairs of exponentially correlated (Gauss–Markov)
+    errors, cov(e_i, e_j) = Σ sd² exp(−|t_i − t_j|/τ). With ``phase`` [rad] the e_i are the
+    projections of an isotropic horizontal error (each axis so correlated, axes independent) on the
+    unit vectors of direction phase_i, which multiplies the covariance by cos(phase_i − phase_j)
+    (e.g. the radial components of a tracking error around a circle)."""
+    t = np.asarray(t, float)
+    w = np.asarray(w, float)
+    comps = [(float(sd), float(tau)) for sd, tau in components if sd > 0.0 and tau > 0.0]
+    if t.size == 0 or not comps:
+        return 0.0
+    dt = np.abs(t[:, None] - t[None, :])
+    C = sum(sd ** 2 * np.exp(-dt / tau) for sd, tau in comps)
+    if phase is not None:
+        ph = np.asarray(phase, float)
+        C = C * np.cos(ph[:, None] - ph[None, :])
+    return float(w @ C @ w)
+
+
 def slope_variance(t, components) -> float:
     """Variance [(unit/s)²] of a least-squares slope over the samples at ``t`` [s] from errors that are
     correlated in time: ``components`` (sd, τ) pairs of exponentially correlated (Gauss–Markov)

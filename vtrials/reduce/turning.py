@@ -40,12 +40,24 @@ MSC/Circ.1053 definitions of advance, transfer and tactical diameter):
 4. Drift-corrected track (:func:`drift_corrected_track`): recorded − drift·(t − t_execute).
 5. Metrics from the corrected track: advance (along ψ₀ from EXECUTE to the 90° heading-change mark),
    transfer (perpendicular, positive toward the turn, at 90°), tactical diameter (perpendicular at
-   180°), steady turning diameter (geometric least-squares circle fit to the steady part), steady speed
-   U = R·|r_ss| (circumference / time for 360°), steady rate of turn (OLS slope of the unwrapped heading
-   over the steady part, SE inflated for lag-1 residual autocorrelation), drift angle β = ψ − χ
-   (heading minus the tangent direction of the fitted circle at each sample, positive bow-in), times to
-   10°, 90° and 180°, distance travelled to 10° (IMO initial turning), steady and maximum heel, mean
-   rudder in the steady part.
+   180°), times to 10°, 90° and 180°, distance travelled to 10° (IMO initial turning), maximum heel.
+6. Steady turn (:func:`steady_loop`): the values of the steady turn come from one full loop of heading,
+   the second one — 360° to 720° of heading change after EXECUTE (the last 360° before FINEX when the
+   turn ends short of 720°) — the definition the references use (:func:`vtrials.truth.metrics.turning`;
+   ITTC 7.5-04-02-01 measures the steady turn once the transient of the first loop has died out, and
+   IMO MSC/Circ.1053 asks for turns of at least 540°, so that a whole steady loop is not always
+   recorded). The rate-of-turn test of step 2 only says whether the turn settled; its steady part
+   usually starts within the first loop, where the speed and radius are still falling (on the patrol
+   vessel's tactical day it started at EXECUTE in most turns, 40 replicates: steady diameter biased
+   −1.1 m, 43 % covered). On the loop: steady turning diameter = geometric least-squares circle
+   fitted to the track less the circle's OWN drift (``loop_drift``: each loop is closed by its own
+   drift, as ITTC's drift correction does; the day's mean drift leaves the side-dependent leeway of the
+   circling ship in the track, and the circle fitted to an open loop of a drifting circle is off by
+   up to drift·T/(2π) in radius, depending on where the loop starts), steady rate of turn = 360° / (time for the loop) (the mean rate of change of
+   heading; in wind the rate varies around the loop and an OLS slope depends on where the loop
+   starts), steady speed U = R·|r_ss| (circumference / time for the loop), drift angle β = ψ − χ
+   (heading minus the tangent direction of the fitted circle at each sample, positive bow-in).
+   Steady heel and mean rudder are taken over the steady part of step 2.
 
 Uncertainties (all 1-σ, combined in quadrature as independent sources):
 * position noise σ_p per axis, estimated from the residuals of piecewise cubic fits (12-sample
@@ -61,6 +73,11 @@ Uncertainties (all 1-σ, combined in quadrature as independent sources):
 * heel: steady = mean roll over the steady part (SE lag-1 corrected); maximum = local quadratic at the
   sample of largest |roll| (SE from the roll noise); steady rudder likewise from the rudder channel;
 * drift angle: SE of the mean of β_i (lag-1 corrected); the gyro/tracking clock offset is not included.
+* steady loop: the two heading-mark times (local quadratic of the gyro, as for the marks) and the
+  gyro's slow wander between them (Gauss–Markov σ_d, τ of the maker's specification:
+  Var = 2σ_d²(1 − e^{−T/τ}), as a time error of ÷|r|) give σ_T, hence σ_r = |r| σ_T / T; the circle's
+  radius: the fit's covariance plus its sensitivity to the loop drift through the drift's covariance;
+  U: σ_U² = r² σ_R² + R² σ_r².
 
 Rate of turn vs rudder (:func:`rudder_breakdown`, seed 002 Fig. 12): turns grouped by approach speed
 and side; breakdown = the steady rate falls significantly (one-sided z test on the two SEs) when the
@@ -77,7 +94,8 @@ import numpy as np
 from scipy import optimize, stats
 
 from vtrials.reduce.estimate import Estimate
-from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation, slope_variance
+from vtrials.reduce.series import clean_series as _clean, ar1_inflation as _ar1_inflation, slope_variance, \
+    correlated_variance
 
 TWO_PI = 2.0 * math.pi
 
@@ -228,6 +246,17 @@ def fit_circle(x, y) -> tuple[np.ndarray, np.ndarray, float]:
     return p, cov, math.sqrt(s2)
 
 
+def _circle_radius_weights(x, y, p) -> tuple[np.ndarray, np.ndarray]:
+    """Weights h with δR = Σ h_k δρ_k for small radial errors δρ_k of the points (x_k, y_k) about the
+    fitted circle p = (cx, cy, R) (row R of the Gauss–Newton pseudo-inverse), and the points' polar
+    angles about the centre [rad]."""
+    dx, dy = np.asarray(x, float) - p[0], np.asarray(y, float) - p[1]
+    d = np.hypot(dx, dy)
+    J = np.column_stack([-dx / d, -dy / d, -np.ones_like(d)])
+    H = np.linalg.pinv(J.T @ J) @ J.T
+    return -H[2], np.arctan2(dy, dx)
+
+
 def _circ_mean(a: np.ndarray) -> tuple[float, float]:
     """Circular mean of angles [rad] and its standard error (lag-1 corrected)."""
     c, s = np.mean(np.cos(a)), np.mean(np.sin(a))
@@ -355,13 +384,16 @@ def steady_window(t_heading, heading, t_execute: float, *, tol: float = 0.02,
 
 # ------------------------------------------------------------------------------------------- drift
 def drift_from_pairs(t, north, east, t_start: float, t_end: float, period: float,
-                     period_std: float = 0.0, *, min_pairs: int = 5) -> Drift:
+                     period_std: float = 0.0, *, min_pairs: int = 5, fix_errors=()) -> Drift:
     """Drift velocity [m/s] from positions one steady turning period [s] (360° of heading) apart.
 
     Pairs (t_i, t_i + period) for every tracking sample t_i ∈ [t_start, t_end − period]; the partner
     position is a 4-point Lagrange interpolation. Returns the mean of the pair drifts with the
     pair-scatter standard error described in the module docstring (``detail['se_batch_*']`` holds a
-    batch-means SE over ≤ 10 blocks of consecutive pairs as a diagnostic).
+    batch-means SE over ≤ 10 blocks of consecutive pairs as a diagnostic). ``fix_errors``: the
+    tracking's time-correlated errors per axis, (sd [m], τ [s]) pairs: a wander slower than the
+    period moves every pair alike, so the pair scatter cannot see it; its variance in the mean drift
+    is propagated through the same sample weights (:func:`vtrials.reduce.series.correlated_variance`).
     """
     t, n_, e_ = _clean(t, north, east)
     T = float(period)
@@ -396,7 +428,8 @@ def drift_from_pairs(t, north, east, t_start: float, t_end: float, period: float
     # per-axis noise variance implied by the pair scatter
     s2N = T ** 2 * float(np.sum((dN - DN) ** 2)) / float(np.sum(cmult)) * npair / (npair - 1)
     s2E = T ** 2 * float(np.sum((dE - DE) ** 2)) / float(np.sum(cmult)) * npair / (npair - 1)
-    cov = np.diag([s2N * sum_a2, s2E * sum_a2])
+    s2c = correlated_variance(t, a, fix_errors)
+    cov = np.diag([s2N * sum_a2 + s2c, s2E * sum_a2 + s2c])
     # period error: mean water velocity at the partner points
     t1, t2 = t[rows[0][0]] + T, t[rows[-1][0]] + T
     if t2 - t1 > 0 and period_std > 0:
@@ -530,7 +563,7 @@ def drift_from_circle_fit(t, north, east, t_start: float, t_end: float, omega0: 
 
 
 def estimate_drift(t, north, east, t_heading, heading, t_execute: float, *, method: str = "auto",
-                   steady: SteadyWindow | None = None, **steady_kw) -> tuple[Drift, SteadyWindow]:
+                   steady: SteadyWindow | None = None, fix_errors=(), **steady_kw) -> tuple[Drift, SteadyWindow]:
     """Drift of a tactical circle. ``method``: 'pairs' (seed 002, used by the report), 'heading_pairs',
     'circle' (moving-centre fit) or 'auto' (pairs; the circle fit when the steady part has fewer than
     5 pairs). Returns the drift and the steady window used."""
@@ -540,7 +573,7 @@ def estimate_drift(t, north, east, t_heading, heading, t_execute: float, *, meth
     T_std = TWO_PI * r.std / r.value ** 2 if math.isfinite(r.std) else 0.0
     if method in ("pairs", "auto"):
         try:
-            return drift_from_pairs(t, north, east, sw.t_start, sw.t_end, T, T_std), sw
+            return drift_from_pairs(t, north, east, sw.t_start, sw.t_end, T, T_std, fix_errors=fix_errors), sw
         except ValueError:
             if method == "pairs":
                 raise
@@ -638,12 +671,73 @@ def _mark_time(th, psi_rel, level, after, sig, rate_guess):
     return float(tc), float(st), float(slope)
 
 
+@dataclasses.dataclass(frozen=True)
+class SteadyLoop:
+    """The loop of heading the steady-turn values come from (:func:`steady_loop`): its start and end
+    times [s], the heading change over it [rad] and the standard error of its duration [s]."""
+
+    t_start: float
+    t_end: float
+    heading_change: float
+    duration_std: float
+    full: bool  # True: 360° → 720°; False: the last 360° before FINEX (turn shorter than 720°)
+
+
+def steady_loop(t_heading, heading, t_execute: float, t_finex: float | None = None, *,
+                sigma_heading: float | None = None, gyro_drift: tuple[float, float] = (0.0, 1.0),
+                pre_s: float = 10.0) -> SteadyLoop | None:
+    """The steady loop of a turn from the gyro [s, rad]: 360° → 720° of heading change after EXECUTE,
+    or the last 360° before FINEX when the turn ends short of 720° (None below 450°: the loop would
+    start before 90°). Heading change counted from the heading at EXECUTE (local line through the
+    ``pre_s`` seconds of gyro before it), as the reference does (:func:`vtrials.truth.metrics.turning`).
+
+    The loop's ends are heading-mark times (:func:`_mark_time`); ``duration_std`` combines their
+    SEs with the gyro's slow wander between them (Gauss–Markov (σ_d, τ): a heading error difference of
+    variance 2σ_d²(1 − e^{−T/τ}), divided by |r| to a time)."""
+    th, psi = _clean(t_heading, heading)
+    psi = np.unwrap(psi)
+    t_finex = float(th[-1]) if t_finex is None else float(t_finex)
+    sig = sigma_heading if sigma_heading is not None else noise_sigma(th, psi)[0]
+    pre = (th >= t_execute - pre_s) & (th <= t_execute)
+    if np.count_nonzero(pre) < 3:
+        return None
+    psi_x = _local_poly(th[pre], psi[pre], t_execute, pre_s, 1, sig)[0]
+    m = (th >= t_execute) & (th <= t_finex + 1e-9)
+    th, psi = th[m], psi[m]
+    if th.size < 20:
+        return None
+    side = 1.0 if psi[-1] >= psi_x else -1.0
+    d = side * (psi - psi_x)
+    total = float(d[-1])
+    full = total >= 2 * TWO_PI
+    lo, hi = (TWO_PI, 2 * TWO_PI) if full else (total - TWO_PI, total)
+    if lo < math.radians(90.0):
+        return None
+    r_guess = total / max(float(th[-1] - th[0]), 1e-9)
+    a = _mark_time(th, d, lo, t_execute, sig, r_guess)
+    if a is None:
+        return None
+    if full:
+        b = _mark_time(th, d, hi, a[0], sig, r_guess)
+        if b is None:
+            return None
+        t_hi, se_hi, slope = b
+    else:  # the loop ends at the last sample: its heading's noise moves the start mark instead
+        t_hi, se_hi, slope = float(th[-1]), sig / max(a[2], 1e-12), a[2]
+    T = t_hi - a[0]
+    sd_d, tau = gyro_drift
+    wander = 2.0 * sd_d ** 2 * (1.0 - math.exp(-T / tau)) if sd_d > 0 and tau > 0 else 0.0
+    sT = math.sqrt(a[1] ** 2 + se_hi ** 2 + wander / max(abs(slope), 1e-12) ** 2)
+    return SteadyLoop(float(a[0]), float(t_hi), float(hi - lo), sT, bool(full))
+
+
 def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None, roll=None, t_roll=None,
                     rudder=None, t_rudder=None, drift="auto", approach_s: float = 60.0,
                     steady: SteadyWindow | None = None, steady_tol: float = 0.02,
                     min_span_deg: float = 90.0, mark_window_deg: float = 10.0,
                     sigma_fix: float = 0.0, current=None, roll_bias: float = 0.0, fix_errors=(),
-                    timing_sd: float = 0.0) -> TurningResult:
+                    timing_sd: float = 0.0, loop_drift=None, t_finex: float | None = None,
+                    gyro_drift: tuple[float, float] = (0.0, 1.0)) -> TurningResult:
     """Turning-circle metrics from recorded channels (see the module docstring for definitions).
 
     Parameters: ``t, north, east`` tracking [s, m, m]; ``heading`` gyro [rad] on ``t_heading`` (the
@@ -662,7 +756,10 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     ``fix_errors`` the tracking's time-correlated errors per axis, (sd [m], τ [s]) pairs, for the
     approach velocity's variance (:func:`vtrials.reduce.series.slope_variance`); ``timing_sd`` [s] the
     standard uncertainty of each logger's time stamps against the run log's (clock offset and drift):
-    a mark's time against the fixes carries two of them, the EXECUTE point one.
+    a mark's time against the fixes carries two of them, the EXECUTE point one. ``loop_drift``: the
+    circle's own drift (a :class:`Drift` or (v_N, v_E) [m/s]) the steady loop is closed with (default:
+    ``drift``); ``t_finex`` [s] the end of the turn (default: the last gyro sample); ``gyro_drift``
+    the gyro's slow wander (σ [rad], τ [s]) for the steady loop's duration (:func:`steady_loop`).
     """
     notes: list[str] = []
     tp, N, E = _clean(t, north, east)
@@ -706,7 +803,8 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     drift_obj: Drift | None
     if isinstance(drift, str):
         try:
-            drift_obj, _ = estimate_drift(tp, N, E, th, psi, t_execute, method=drift, steady=sw)
+            drift_obj, _ = estimate_drift(tp, N, E, th, psi, t_execute, method=drift, steady=sw,
+                                          fix_errors=fix_errors)
             if drift_obj.method == "circle" and drift == "auto":
                 notes.append("drift from the moving-circle fit (steady part too short for 360-deg pairs)")
         except (ValueError, np.linalg.LinAlgError) as exc:
@@ -805,28 +903,46 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
             res.time_to_180 = tm_est
             res.tactical_diameter = Estimate(across, sc)
 
-    # steady part: circle fit to the corrected track, speed, rate, drift angle
-    res.steady_rate = sw.rate
-    ms = (tp >= sw.t_start) & (tp <= sw.t_end)
-    if np.count_nonzero(ms) >= 12 and sw.span >= math.radians(60.0):
-        p, cov, rms = fit_circle(Nc[ms], Ec[ms])
+    # steady turn: one loop of heading (360° → 720°), the track closed by the circle's own drift;
+    # circle fit, rate = heading change / time for the loop, speed = R·rate, drift angle
+    loop = steady_loop(th, psi, t_execute, t_finex, sigma_heading=sig_psi, gyro_drift=gyro_drift)
+    if loop is None:
+        res.steady_rate = sw.rate
+        notes.append("no steady loop (the turn ends before 450 deg of heading change)")
+    else:
+        T = loop.t_end - loop.t_start
+        rate = side * loop.heading_change / T
+        res.steady_rate = Estimate(rate, abs(rate) * loop.duration_std / T)
+        notes.append(f"steady values over the loop {'360-720 deg' if loop.full else 'last 360 deg'} "
+                         f"of heading change, t = {loop.t_start:.1f}-{loop.t_end:.1f} s")
+    ld = drift_obj if loop_drift is None else _as_drift(loop_drift)
+    ms = (tp >= loop.t_start) & (tp <= loop.t_end) if loop is not None else np.zeros(tp.shape, bool)
+    if np.count_nonzero(ms) >= 12:
+        Sl = ld.cov if ld is not None else np.zeros((2, 2))
+        Nl, El = drift_corrected_track(tp, N, E, t_execute, ld) if ld is not None else (N, E)
+        p, cov, rms = fit_circle(Nl[ms], El[ms])
         R = float(p[2])
-        varR = float(cov[2, 2])
-        if drift_obj is not None and np.any(Sd > 0):
+        # the radius is a linear functional of the radial position errors (Gauss–Newton at the
+        # solution): white tracking noise σ_p and the tracking's time-correlated errors; the fit's own
+        # residual scatter would also count the wind's non-circularity of the loop, which the
+        # reference shares
+        h, theta_k = _circle_radius_weights(Nl[ms], El[ms], p)
+        varR = 0.5 * (sigN ** 2 + sigE ** 2) * float(h @ h) + correlated_variance(tp[ms], h, fix_errors, theta_k)
+        if ld is not None and np.any(Sl > 0):
             g = np.zeros(2)
             for j in range(2):
                 h = 1e-4
-                dd = drift_obj.vector.copy()
+                dd = ld.vector.copy()
                 dd[j] += h
                 N2, E2 = drift_corrected_track(tp[ms], N[ms], E[ms], t_execute, tuple(dd))
                 g[j] = (fit_circle(N2, E2)[0][2] - R) / h
-            varR += float(g @ Sd @ g)
+            varR += float(g @ Sl @ g)
         res.steady_diameter = Estimate(2 * R, 2 * math.sqrt(varR))
-        rr = sw.rate
+        rr = res.steady_rate
         res.steady_speed = Estimate(R * abs(rr.value), math.sqrt((abs(rr.value)) ** 2 * varR
                                                                  + (R * rr.std) ** 2))
         # drift angle: heading minus the tangent direction of the fitted circle
-        theta = np.arctan2(Ec[ms] - p[1], Nc[ms] - p[0])
+        theta = np.arctan2(El[ms] - p[1], Nl[ms] - p[0])
         chi = theta + side * math.pi / 2
         psi_t = np.interp(tp[ms], th, psi)
         beta = side * np.angle(np.exp(1j * (psi_t - chi)))
@@ -836,7 +952,7 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         if not sw.steady:
             notes.append("steady diameter / speed / drift angle come from a record that never settled")
     else:
-        notes.append("steady part too short for a circle fit")
+        notes.append("steady loop too short for a circle fit")
 
     if roll is not None:
         tr, ro = _clean(t if t_roll is None else t_roll, roll)

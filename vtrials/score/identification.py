@@ -55,11 +55,16 @@ def _truth_of(record: str) -> dict:
 def score(result: dict) -> dict:
     """Errors of the identified coefficients (with interval coverage) and of the held-back predictions."""
     truth = true_coefficients(result["ship"])
-    coeffs = {}
-    for k, c in result["coefficients"].items():
-        t = truth.get(k, 0.0)
-        coeffs[k] = {"truth": t, "error": c["value"] - t, "rel_error": (c["value"] - t) / t if t else None,
-                     "covered": bool(c["lo95"] <= t <= c["hi95"])}
+
+    def against_truth(cs):
+        out = {}
+        for k, c in cs.items():
+            t = truth.get(k, 0.0)
+            out[k] = {"truth": t, "error": c["value"] - t, "rel_error": (c["value"] - t) / t if t else None,
+                      "covered": bool(c["lo95"] <= t <= c["hi95"])}
+        return out
+
+    coeffs = against_truth(result["coefficients"])
     checked = result.get("intervals_checked") or ("Y_v", "Y_r", "N_v", "N_r")
     linear = {k: coeffs[k]["rel_error"] for k in checked if k in coeffs}
     preds = []
@@ -81,6 +86,11 @@ def score(result: dict) -> dict:
     verdict = {"linear_within_10pct": max_lin is not None and max_lin <= LIMITS["linear_rel"],
                "turns_within_5pct": worst["turn_rel"] <= LIMITS["turn_rel"] if preds else None,
                "overshoots_within_1p5deg": worst["overshoot_deg"] <= LIMITS["overshoot_deg"] if preds else None}
-    return {"coefficients": coeffs, "linear_rel_error": linear, "max_linear_rel_error": max_lin,
+    extra = {}
+    if "output_error" in result:   # the output-error refinement, scored the same way
+        oe = against_truth(result["output_error"]["coefficients"])
+        extra["output_error"] = {"coefficients": oe,
+                                 "linear_rel_error": {k: oe[k]["rel_error"] for k in checked if k in oe}}
+    return {**extra, "coefficients": coeffs, "linear_rel_error": linear, "max_linear_rel_error": max_lin,
             "predictions": preds, "worst": worst, "verdict": verdict,
             "coverage": {"n": len(coeffs), "covered": sum(c["covered"] for c in coeffs.values())}}

@@ -84,6 +84,16 @@ def _at_gauge(iset, ref: dict, rps: list[float]) -> dict:
     return {**ref, "power": gauge_power(iset, ref["power"], rps), "delivered_power": ref["power"]}
 
 
+def spot_stw_truth(runs: list[dict]) -> float:
+    """A spot's true speed through water from its runs' truth references (``stw``, ``heading``): the
+    heading-balanced mean ½(mean over the runs on the first run's course + mean over the reciprocal
+    runs) — the quantity current elimination estimates."""
+    c0 = runs[0]["heading"]
+    base = [x["stw"] for x in runs if math.cos(x["heading"] - c0) > 0]
+    recip = [x["stw"] for x in runs if math.cos(x["heading"] - c0) <= 0]
+    return 0.5 * (np.mean(base) + np.mean(recip))
+
+
 def score_standardization(reduced: dict, res, name: str) -> dict:
     crew = res.crew
     truth = {k: _at_gauge(crew.iset, r, [sh["rps"] for sh in r["shafts"]]) for k, r in _truth_of(crew, name).items()}
@@ -100,9 +110,7 @@ def score_standardization(reduced: dict, res, name: str) -> dict:
     for s in reduced["spots"]:
         rr = [truth[k] for k in s["runs"]]
         c0 = rr[0]["heading"]
-        base = [x["stw"] for x in rr if math.cos(x["heading"] - c0) > 0]
-        recip = [x["stw"] for x in rr if math.cos(x["heading"] - c0) <= 0]
-        stw_true = 0.5 * (np.mean(base) + np.mean(recip))
+        stw_true = spot_stw_truth(rr)
         # true current along the spot's first course, per run (what the elimination implies)
         h = (math.cos(c0), math.sin(c0))
         cur_true = [x["current_n"] * h[0] + x["current_e"] * h[1] for x in rr]

@@ -48,6 +48,12 @@ class Refined:
     cov: np.ndarray
     rms: float
     nfev: int
+    jac: np.ndarray | None = None        # weighted residuals' Jacobian (m, p) at the solution
+    residuals: np.ndarray | None = None  # weighted residuals (m,) at the solution
+    bounds: tuple = ()                   # start of each (maneuver, channel) block in the residuals
+    cov_white: np.ndarray | None = None  # s² (JᵀJ)⁻¹: the covariance if the residuals were white
+    lags: int = 0                        # Newey–West bandwidth used, samples
+    fixed_b: float = 1.0                 # the fixed-b widening folded into ``cov`` (:func:`fixed_b_factor`)
 
     def sigma(self) -> dict:
         return dict(zip(self.free, np.sqrt(np.diag(self.cov))))
@@ -110,6 +116,16 @@ def simulate(ship, coeffs: dict, man: Maneuver, t_eval) -> np.ndarray:
     return simulate_batch(ship, terms, np.array([[coeffs[t] for t in terms]]), man, t_eval)[0]
 
 
+def fixed_b_factor(b: float) -> float:
+    """Widening of a ±1.96 σ interval whose σ is a Bartlett-kernel (Newey–West) HAC estimate with
+    bandwidth b × the record length: the 97.5 % point of the fixed-b limit of the t statistic over 1.96.
+    Kiefer, N. M. & Vogelsang, T. J. (2005) "A new asymptotic theory for heteroskedasticity-
+    autocorrelation robust tests", Econometric Theory 21:1130–1164 — their cubic fit of the Bartlett
+    kernel's critical values, cv(b) = 1.9600 + 2.9694 b + 0.4160 b² − 0.5324 b³ (b ≤ 1)."""
+    b = min(max(float(b), 0.0), 1.0)
+    return (1.9600 + 2.9694 * b + 0.4160 * b**2 - 0.5324 * b**3) / 1.9600
+
+
 def _residuals_batch(ship, terms, C, maneuvers, rtol=1e-5, atol=1e-7, bounds=None):
     """Weighted residuals (P, m) for P coefficient sets over all maneuvers and channels; the start
     index of each (maneuver, channel) block is appended to ``bounds`` if given."""
@@ -131,14 +147,21 @@ def _residuals_batch(ship, terms, C, maneuvers, rtol=1e-5, atol=1e-7, bounds=Non
 
 
 def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfev: int = 20,
-           lags: int = 20, rtol: float = 1e-5, atol: float = 1e-7) -> Refined:
+           lags: int | str = 20, rtol: float = 1e-5, atol: float = 1e-7) -> Refined:
     """Levenberg–Marquardt refinement of the ``free`` coefficients (others held at ``coeffs0``).
 
     Covariance: (JᵀJ)⁻¹ M (JᵀJ)⁻¹ with M the Newey–West sum of J_tᵀ e_t e_{t−l} J_{t−l} over
     ``lags`` samples within each (maneuver, channel) record — the coloured-residual correction of
     Morelli & Klein (1997), J. Guid. Control Dyn. 20(4):796 — since output-error residuals are
-    correlated in time; ``lags = 0`` gives the white-residual s² (JᵀJ)⁻¹ (up to the s² estimate).
-    ``rtol``/``atol``: integration tolerances of the model."""
+    correlated in time. With the bandwidth a sizeable fraction b of a record, the Newey–West variance is
+    biased low and itself uncertain; ``cov`` is scaled by the fixed-b factor (:func:`fixed_b_factor`),
+    so that ±1.96 σ is Kiefer & Vogelsang's (2005) 95 % interval. ``lags = 0`` gives the white-residual
+    s² (JᵀJ)⁻¹ (up to the s² estimate);
+    ``lags = "auto"``: Andrews' (1991) bandwidth from the residuals' lag-1 correlation
+    (:func:`vtrials.sysid.regression.andrews_lags`). ``rtol``/``atol``: integration tolerances of the
+    model. The result also holds the white-residual covariance s² (JᵀJ)⁻¹ (``cov_white``; s² the
+    residuals' mean square with m − p degrees of freedom): their diagonal ratio is the effective-sample
+    correction n/n_eff the coloured residuals call for."""
     terms = tuple(coeffs0)
     free = tuple(free)
     for f in free:
@@ -177,6 +200,9 @@ def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfe
     bounds: list = []
     _residuals_batch(ship, terms, full(res.x)[None, :], maneuvers, rtol, atol, bounds)
     m, p = r.size, len(free)
+    if lags == "auto":
+        from vtrials.sysid.regression import andrews_lags
+        lags = andrews_lags(r, bounds)
     g = J * r[:, None]
     M = g.T @ g
     for lag in range(1, lags + 1):
@@ -185,7 +211,51 @@ def refine(ship, coeffs0: dict, free, maneuvers, rel_step: float = 1e-4, max_nfe
             if b - a > lag:
                 G += g[a + lag:b].T @ g[a:b - lag]
         M += (1.0 - lag / (lags + 1.0)) * (G + G.T)
-    H = np.linalg.inv(J.T @ J)
-    cov = H @ M @ H * m / (m - p)
+    H = np.linalg.pinv(J.T @ J)
+    sizes = np.diff(bounds)
+    factor = fixed_b_factor(lags / float(np.mean(sizes[sizes > 0])))
+    cov = H @ M @ H * m / (m - p) * factor**2
     out = dict(zip(terms, full(res.x)))
-    return Refined(out, free, cov, float(np.sqrt(np.mean(r**2))), int(res.nfev))
+    return Refined(out, free, cov, float(np.sqrt(np.mean(r**2))), int(res.nfev), J, r, tuple(bounds),
+                   H * float(r @ r) / (m - p), int(lags), float(factor))
+
+
+def channel_sigmas(ship, coeffs: dict, maneuvers, floor: dict | None = None, rtol: float = 1e-5,
+                   atol: float = 1e-7) -> dict:
+    """Each channel's output-error standard deviation: the RMS over all maneuvers of the model's
+    (simulated − measured) at ``coeffs`` — the maximum-likelihood estimate of a diagonal measurement-
+    noise covariance for fixed parameters (Jategaonkar 2006, ch. 4, the relaxation step of the
+    output-error method; Maine & Iliff 1986, NASA RP-1168), never below ``floor`` {channel: σ} (the
+    measurement's own stated σ)."""
+    terms = tuple(coeffs)
+    C = np.array([[coeffs[t] for t in terms]])
+    sq: dict = {}
+    for man in maneuvers:
+        ones = dataclasses.replace(man, outputs={ch: (tc, z, 1.0) for ch, (tc, z, _) in man.outputs.items()})
+        bounds: list = []
+        e = _residuals_batch(ship, terms, C, [ones], rtol, atol, bounds)[0]
+        for ch, a, b in zip(ones.outputs, bounds[:-1], bounds[1:]):
+            sq.setdefault(ch, []).append(e[a:b])
+    out = {ch: float(np.sqrt(np.mean(np.concatenate(v)**2))) for ch, v in sq.items()}
+    return {ch: max(s, (floor or {}).get(ch, 0.0)) for ch, s in out.items()}
+
+
+def with_sigmas(maneuvers, sigmas: dict) -> list:
+    """The maneuvers with every channel's σ replaced by ``sigmas[channel]``."""
+    return [dataclasses.replace(m, outputs={ch: (tc, z, sigmas[ch]) for ch, (tc, z, _) in m.outputs.items()})
+            for m in maneuvers]
+
+
+def shift(ship, res: Refined, maneuvers, i: int, perturbed: Maneuver, rtol: float = 1e-5,
+          atol: float = 1e-7) -> np.ndarray:
+    """Linearised change of the free coefficients if maneuver ``i``'s data (inputs, initial state or
+    outputs) were ``perturbed`` instead: δp = −(JᵀJ)⁻¹ Jᵢᵀ δrᵢ, δrᵢ the change of that maneuver's
+    weighted residuals at the solution (one Gauss–Newton step; the GUM's sensitivity, JCGM 100:2008
+    §5.1, of the output-error estimate to an error common to one record)."""
+    terms = tuple(res.coeffs)
+    C = np.array([[res.coeffs[t] for t in terms]])
+    start = sum(sum(np.size(v[0]) for v in m.outputs.values()) for m in maneuvers[:i])
+    base = _residuals_batch(ship, terms, C, [maneuvers[i]], rtol, atol)[0]
+    new = _residuals_batch(ship, terms, C, [perturbed], rtol, atol)[0]
+    Ji = res.jac[start:start + base.size]
+    return -np.linalg.pinv(res.jac.T @ res.jac) @ (Ji.T @ (new - base))

@@ -126,6 +126,49 @@ def _hac(A, e, bounds, lags: int):
     return S
 
 
+def hac_sigmas(A, y, coef, bounds, lags_list) -> dict:
+    """σ of the OLS coefficients under the Newey–West covariance (as :func:`ols`) at each bandwidth of
+    ``lags_list`` at once: the scores' lagged cross-products within each segment from one FFT
+    (Wiener–Khinchin; the same sums :func:`_hac` forms lag by lag, to rounding)."""
+    A = np.asarray(A, float)
+    n, p = A.shape
+    e = np.asarray(y, float) - A @ coef
+    g = A * e[:, None]
+    top = int(max(lags_list))
+    C = np.zeros((top + 1, p, p))
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        m = b - a
+        if m < 1:
+            continue
+        nfft = 1 << int(np.ceil(np.log2(2 * m)))
+        F = np.fft.rfft(g[a:b], nfft, axis=0)
+        c = np.fft.irfft(F[:, :, None] * np.conj(F[:, None, :]), nfft, axis=0)   # Σ_t g_i[t+l] g_j[t]
+        k = min(top, m - 1)
+        C[:k + 1] += c[:k + 1]
+    AtA_inv = np.linalg.pinv(A.T @ A)
+    out = {}
+    for L in lags_list:
+        S = C[0].copy()
+        for lag in range(1, int(L) + 1):
+            S += (1.0 - lag / (L + 1.0)) * (C[lag] + C[lag].T)
+        out[L] = np.sqrt(np.diag(AtA_inv @ S @ AtA_inv) * n / (n - p))
+    return out
+
+
+def plateau_sigma(A, y, coef, bounds, ladder) -> tuple[np.ndarray, dict]:
+    """The largest Newey–West σ of each coefficient over the bandwidths of ``ladder`` (those up to a
+    quarter of the shortest segment) and Andrews' (:func:`andrews_lags`); also {bandwidth: σ}. For
+    residuals that mix white noise with a slow error, the AR(1) plug-in sees the white part's lag-1
+    correlation and picks too short a bandwidth; the σ levels off once the bandwidth spans the slow
+    error's correlation (and falls beyond only through the Bartlett window's bias): its plateau."""
+    A = np.asarray(A, float)
+    e = np.asarray(y, float) - A @ coef
+    cap = max(1, int(np.diff(bounds).min()) // 4)
+    lad = [int(L) for L in ladder if L <= cap]
+    sig = hac_sigmas(A, y, coef, bounds, sorted(set(lad + [andrews_lags(e, bounds)])))
+    return np.max(np.array(list(sig.values())), axis=0), sig
+
+
 def _lag1(e, bounds) -> float:
     """Lag-1 autocorrelation of residuals pooled within segments (never across a boundary)."""
     num = sum(float(np.dot(e[a + 1:b], e[a:b - 1])) for a, b in zip(bounds[:-1], bounds[1:]) if b - a > 1)

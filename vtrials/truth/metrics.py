@@ -57,10 +57,16 @@ def turning(t, x_w, y_w, heading, u_r, v_r, r, *, steady_from_deg: float = 360.0
     """Turning-circle metrics from EXECUTE (index 0 of the arrays).
 
     advance: distance along the approach heading from EXECUTE to 90° heading change; transfer:
-    distance perpendicular to it at 90°; tactical diameter: perpendicular at 180°; steady
-    turning diameter: circle fitted to the water track between ``steady_from_deg`` and
-    ``steady_to_deg`` of heading change (the last 360° recorded if the turn is shorter);
-    steady speed and rate of turn: means over the same window.
+    distance perpendicular to it at 90°; tactical diameter: perpendicular at 180°.
+
+    Steady turn, over the steady loop between ``steady_from_deg`` and ``steady_to_deg`` of heading
+    change (the last 360° recorded if the turn is shorter; ends at the interpolated crossings):
+    steady turning diameter = least-squares circle fitted to the water track less the loop's own drift
+    (its displacement between the loop's ends over the loop's duration — the wind's leeway of the
+    circling ship, which ITTC 7.5-04-02-01's drift correction removes loop by loop; a circle fitted
+    to the open loop is off by up to drift·T/(2π) in radius, depending on where the loop starts); steady rate of turn = heading change over the loop / its duration (the mean rate
+    of change of heading, as the independent MMG reference of the tests defines it: ∫|r|dt / T);
+    steady speed = mean speed through the water over the loop.
     """
     t = np.asarray(t, float)
     psi0 = heading[0]
@@ -96,13 +102,23 @@ def turning(t, x_w, y_w, heading, u_r, v_r, r, *, steady_from_deg: float = 360.0
         lo, hi = total - 2 * math.pi, total
     if lo >= math.radians(90.0):
         m = (dpsi >= lo) & (dpsi <= hi)
-        if np.count_nonzero(m) >= 10:
-            _, _, R = fit_circle(x_w[m], y_w[m])
+        c_lo = _first_crossing(t, dpsi, lo)
+        t_lo = c_lo[0] if c_lo is not None else float(t[0])
+        c_hi = _first_crossing(t, dpsi, hi) if hi < total else None
+        t_hi = c_hi[0] if c_hi is not None else float(t[-1])
+        if np.count_nonzero(m) >= 10 and t_hi > t_lo:
+            T = t_hi - t_lo
+            dn = (_interp(t, x_w, t_hi) - _interp(t, x_w, t_lo)) / T
+            de = (_interp(t, y_w, t_hi) - _interp(t, y_w, t_lo)) / T
+            _, _, R = fit_circle(x_w[m] - dn * (t[m] - t_lo), y_w[m] - de * (t[m] - t_lo))
             out["steady_turning_diameter_m"] = 2.0 * R
+            out["steady_loop_drift_mps"] = [float(dn), float(de)]
+            out["steady_loop_s"] = [float(t_lo), float(t_hi)]
             out["steady_speed_mps"] = float(np.mean(np.hypot(u_r[m], v_r[m])))
             # rate of turn: the rate of change of heading (a heeled ship's body yaw rate is smaller by
-            # cos φ cos θ)
-            out["steady_rate_of_turn_dps"] = float(np.degrees(abs(np.polyfit(t[m], heading[m], 1)[0])))
+            # cos φ cos θ), its mean over the loop
+            dh = _interp(t, heading, t_hi) - _interp(t, heading, t_lo)
+            out["steady_rate_of_turn_dps"] = float(np.degrees(abs(dh) / T))
             out["steady_drift_angle_deg"] = float(np.degrees(np.mean(np.arctan2(-v_r[m], u_r[m]))))
     return out
 
