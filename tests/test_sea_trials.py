@@ -34,8 +34,8 @@ Checked:
   zero by construction; patrol51's C_B 0.35 lies outside both methods' regression range.
 
 Why 10-min runs: the mean speed of a 180-s run with the sea 35° off the stern scatters by 0.034 m/s at
-7.3 m/s (free-running patrol51 at fixed settings, 8 seeds × 7 windows; the same with either timing of
-the radiation memory), which moves the slow spot's power at equal speed by about as much as the wave
+7.3 m/s (free-running patrol51 at fixed settings, 8 seeds × 7 windows, benchmarks/radiation_timing.py;
+0.0336 and 0.0341 m/s with the two timings of the radiation memory), which moves the slow spot's power at equal speed by about as much as the wave
 correction the last check is about. With 180-s runs the checks held on 17 of 19 wave seeds with the
 radiation memory lagging a step and on 10 of 19 with it centred in time (benchmarks/results/
 sea_trials_seeds*.json; the into-sea runs agree between the two to 0.001 m/s on average, the runs with
