@@ -10,7 +10,8 @@ before; there patrol51 does not hold its course in these seas (heading standard 
 seeds 4322–4326 with the radiation memory lagging a step, 19–144° with it centred in time, which gives
 the lightly damped roll its full resonance), and the fused H_s was 1.13, 1.41, 1.35, 1.18, 1.08 × the
 truth on those seeds before the change, 1.24, 1.09, 1.43, 1.30 after: a coin toss, not a check.
-At 9 m/s: 1.050 and 1.025 before, 1.093 and 1.029 after (seeds 4322, 4323).
+At 9 m/s (seeds 4322–4325): heading standard deviation 1.7–5.5°, fused H_s 1.050, 1.025, 1.022, 1.055 ×
+the truth before, 1.093, 1.029, 1.028, 1.058 after.
 
 * ship as a wave buoy: H_s within 15 %, mean direction within 15°, port/starboard right (16 runs in
   benchmarks/results/shipbuoy_sim.json: directions 16/16 within 13°, sides 16/16; H_s 9/16 within 15 %,
