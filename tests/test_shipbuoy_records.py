@@ -7,7 +7,7 @@ average, seed 004). Both reductions assume one relative wave direction over the 
 one whose course was held: the test checks the gyro heading's standard deviation against the 10° with
 which benchmarks/campaign_wavefusion.py accepts a leg (measured 2.6°). The leg was at 8 kn (ahead 1/3)
 before; there patrol51 does not hold its course in these seas (heading standard deviation 17–38° over
-seeds 4322–4326 with the radiation memory lagging a step, 19–144° with it centred in time, which gives
+seeds 4322–4326 with the radiation memory lagging a step, 19–144° on 4322–4325 with it centred, which gives
 the lightly damped roll its full resonance), and the fused H_s was 1.13, 1.41, 1.35, 1.18, 1.08 × the
 truth on those seeds before the change, 1.24, 1.09, 1.43, 1.30 after: a coin toss, not a check.
 At 9 m/s (seeds 4322–4325): heading standard deviation 1.7–5.5°, fused H_s 1.050, 1.025, 1.022, 1.055 ×
