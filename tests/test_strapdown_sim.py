@@ -97,11 +97,15 @@ def test_mirror_integration_on_non_periodic_records(f0):
 
 def test_strapdown_on_a_short_simulated_record():
     S = _bench()
-    rec = S.simulate_array(3.0, 7.0, 120.0, 10.0, 200.0, n_components=60)
+    # seed 3: the ship rolls 10.5° RMS and yaws through 90° in the stern-quartering sea, a record where
+    # the nonlinear (rotation) terms matter. Measured: roll NRE 5.3 % (mirror) vs 10.8 % (FFT); pitch
+    # NRE 5.4 % vs 23.0 % for the linear strapdown. (Before the radiation memory was centred in time,
+    # seed 1 rolled 12.8° RMS and was used here; it now rolls 9.1° with little yaw, and the linear
+    # method's pitch is only 1.5x worse there.)
+    rec = S.simulate_array(3.0, 7.0, 120.0, 10.0, 200.0, seed=3, n_components=60)
     r = S.reconstruct(rec)
-    assert r["rms_roll"] > 5.0                       # a large roll: the nonlinear terms matter
-    # the mirror integration (default) against the periodic FFT integration on this non-periodic record:
-    # measured roll NRE 4.6 % vs 8.1 % (12.8° RMS)
+    assert r["rms_roll"] > 8.0                       # a large roll: the nonlinear terms matter
+    # the mirror integration (default) against the periodic FFT integration on this non-periodic record
     assert r["nre_roll_pct"] < 0.7 * S.reconstruct(rec, integration="fft")["nre_roll_pct"]
     assert r["nre_roll_pct"] < 10.0 and r["nre_pitch_pct"] < 10.0 and r["nre_heave_pct"] < 20.0
     t = rec["t"]
