@@ -529,52 +529,28 @@ def curve_power(curve: dict, v) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------- log calibration
-def _joint_current_fit(t, heading, vg, vg_std, group, order: int):
-    """|U_g h_i + c(t_i)| least squares: parameters U per group and the current c = (c_N, c_E), a
-    polynomial of degree ``order`` (0–2) in time about the mean leg time, coefficients per second^k.
-
-    Legs weighed by 1/(σᵢ² + τ²), τ the ship's own leg-to-leg speed scatter beyond the tracking's stated
-    σ (:func:`vtrials.reduce.current.ship_scatter`). The groups' speeds carry the tracking σ through
-    the (linearised) fit and τ only through their difference from the group's plain mean of its legs
-    — the reference, whose legs scatter alike (:func:`vtrials.reduce.current.scatter_budget`); the
-    current's covariance is the weighted fit's, scaled to χ²/dof = 1."""
+def _joint_current_fit(t, heading, vg, group, trend: bool):
+    """|U_g h_i + c(t_i)| least squares: parameters U per group, c_N, c_E (and their rates)."""
     groups = sorted(set(group))
     gi = np.array([groups.index(g) for g in group])
     G = len(groups)
     tm = float(np.mean(t))
-    span = max(float(np.ptp(t)), 1.0)
-    tau_t = (t - tm) / span
     hc, hs = np.cos(heading), np.sin(heading)
 
     def model(x):
         U = x[:G][gi]
-        cn = sum(x[G + 2 * k] * tau_t ** k for k in range(order + 1))
-        ce = sum(x[G + 2 * k + 1] * tau_t ** k for k in range(order + 1))
+        cn = x[G] + (x[G + 2] * (t - tm) if trend else 0.0)
+        ce = x[G + 1] + (x[G + 3] * (t - tm) if trend else 0.0)
         return np.hypot(U * hc + cn, U * hs + ce)
 
-    x0 = np.concatenate([[np.mean(vg[gi == k]) for k in range(G)], np.zeros(2 * (order + 1))])
+    x0 = np.concatenate([[np.mean(vg[gi == k]) for k in range(G)], [0.0, 0.0], [0.0, 0.0] if trend else []])
+    res = optimize.least_squares(lambda x: model(x) - vg, x0, method="lm", xtol=1e-14, ftol=1e-14)
+    J = res.jac
     n, p = vg.size, x0.size
     dof = n - p
-
-    def solve(tau):
-        w = 1.0 / np.sqrt(vg_std ** 2 + tau ** 2)
-        res = optimize.least_squares(lambda x: (model(x) - vg) * w, x0, method="lm", xtol=1e-14, ftol=1e-14)
-        return w, res.jac, res.x, res.fun / w, float(res.fun @ res.fun)
-
-    fit0 = solve(0.0)
-    tau, (w, J, x, r, chi2) = CUR.ship_scatter(solve, fit0[4], dof, fit0[3], vg_std)
-    s2 = chi2 / dof if dof > 0 else math.nan
+    s2 = float(res.fun @ res.fun) / dof if dof > 0 else math.nan
     cov = np.linalg.pinv(J.T @ J) * s2
-    A = np.linalg.pinv(J) * w[None, :]
-    # the current's coefficients per second^k (the fit's are per span^k)
-    unit = np.concatenate([np.ones(G), np.repeat(span ** -np.arange(order + 1.0), 2)])
-    x, cov = x * unit, cov * np.outer(unit, unit)
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    Ug = []
-    for k in range(G):
-        ref = (gi == k) / float(np.count_nonzero(gi == k))
-        Ug.append(CUR.scatter_budget(A[k], vg_std, tau, ref, dof))
-    return groups, x, cov, sd, Ug, dof, tm, r, tau
+    return groups, res.x, cov, dof, tm, res.fun
 
 
 def reduce_log_calibration(rec: Record) -> dict:
@@ -678,10 +654,9 @@ def resolve_current(t, heading, vg, vg_std, group):
     cannot be resolved.
 
     The joint least-squares fit (:func:`_joint_current_fit`) has G + 2 unknowns (G + 4 with a linear
-    trend, G + 6 with a quadratic one: the richest that leaves at least 3 legs over). It is identified
-    only when there are more legs than unknowns (else no degrees of freedom remain for its uncertainty)
-    and its linearised design [group indicators, cos ψ, sin ψ (, their time-weighted copies)] has full
-    rank: legs all on one
+    trend, used when at least 3 legs are left over). It is identified only when there are more legs
+    than unknowns (else no degrees of freedom remain for its uncertainty) and its linearised design
+    [group indicators, cos ψ, sin ψ (, their time-weighted copies)] has full rank: legs all on one
     axis (reciprocal pairs only) leave the current across that axis unresolved. Then the current is
     reported as under-determined (``current = {"under_determined": why}``) and each group's speed
     through water falls back to the classic per-group estimate that needs no current: the mean of a
@@ -697,32 +672,26 @@ def resolve_current(t, heading, vg, vg_std, group):
     gi = np.array([groups.index(g) for g in group])
     tm = float(np.mean(t))
 
-    def design(order):
-        tt = (t - tm) / max(float(np.ptp(t)), 1.0)
-        cols = [(gi == k).astype(float) for k in range(G)]
-        for k in range(order + 1):
-            cols += [np.cos(heading) * tt ** k, np.sin(heading) * tt ** k]
+    def design(trend):
+        cols = [(gi == k).astype(float) for k in range(G)] + [np.cos(heading), np.sin(heading)]
+        if trend:
+            tt = (t - tm) / max(float(np.ptp(t)), 1.0)
+            cols += [np.cos(heading) * tt, np.sin(heading) * tt]
         return np.column_stack(cols)
 
-    # the current's change with time: the richest polynomial (quadratic: a tide's curvature over a
-    # few hours; linear; constant) that leaves at least 3 legs over and is resolved by the legs
-    order = next((k for k in (2, 1) if n - (G + 2 * (k + 1)) >= 3
-                  and np.linalg.matrix_rank(design(k)) == G + 2 * (k + 1)), 0)
-    trend = order >= 1
-    p = G + 2 * (order + 1)
-    rank = int(np.linalg.matrix_rank(design(order)))
+    trend = n - (G + 4) >= 3 and np.linalg.matrix_rank(design(True)) == G + 4
+    p = G + (4 if trend else 2)
+    rank = int(np.linalg.matrix_rank(design(trend)))
     if n > p and rank == p:
-        groups, x, cov, sd, Ug, dof, tm, resid, tau = _joint_current_fit(t, heading, vg, vg_std, group, order)
-        U = {g: Estimate(float(x[k]), *Ug[k]) for k, g in enumerate(groups)}
+        groups, x, cov, dof, tm, resid = _joint_current_fit(t, heading, vg, group, trend)
+        sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        U = {g: Estimate(float(x[k]), float(sd[k]), dof) for k, g in enumerate(groups)}
         cur = {"north": Estimate(float(x[G]), float(sd[G]), dof),
-               "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof), "trend": trend, "order": order,
-               "t_ref": tm}
-        for k, name in ((1, "rate"), (2, "accel")):
-            if order >= k:
-                cur[f"north_{name}"] = Estimate(float(x[G + 2 * k]), float(sd[G + 2 * k]), dof)
-                cur[f"east_{name}"] = Estimate(float(x[G + 2 * k + 1]), float(sd[G + 2 * k + 1]), dof)
-        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend, "order": order,
-                                "ship_scatter": tau}, []
+               "east": Estimate(float(x[G + 1]), float(sd[G + 1]), dof), "trend": trend, "t_ref": tm}
+        if trend:
+            cur["north_rate"] = Estimate(float(x[G + 2]), float(sd[G + 2]), dof)
+            cur["east_rate"] = Estimate(float(x[G + 3]), float(sd[G + 3]), dof)
+        return groups, U, cur, {"dof": dof, "residuals": resid, "trend": trend}, []
     if rank < p:
         axes = sorted({round(math.degrees(h) % 180.0, 1) for h in heading})
         why = (f"the legs lie on {'one axis' if len(axes) == 1 else 'too few axes'} "
