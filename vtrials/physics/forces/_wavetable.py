@@ -4,7 +4,9 @@ folded onto the database's equally spaced headings 0…π, and linear interpolat
 A component travelling towards μ (from north, clockwise) meets a ship heading ψ at β = μ − ψ in
 (−π, π]; the database holds 0 ≤ β ≤ π and the mirror image gives β < 0 (sway, roll and yaw change
 sign: the database convention of :mod:`vtrials.physics.seakeeping.database`). Used by
-:mod:`vtrials.physics.forces.wave_excitation` and :mod:`vtrials.physics.forces.wave_drift`.
+:mod:`vtrials.physics.forces.wave_excitation` and :mod:`vtrials.physics.forces.wave_drift`; and the
+turn of a seakeeping-frame wrench into body axes (:func:`seakeeping_to_body`) that the excitation and
+the radiation memory (:mod:`vtrials.physics.forces.radiation`) share.
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ from __future__ import annotations
 import math
 
 import numba as nb
+
+from vtrials.physics.forces import context as L
 
 
 @nb.njit(cache=True, inline="always")
@@ -35,3 +39,17 @@ def heading_fold(cm, sm, cp, sp, dh, nbeta):
 def lerp(p, k0, k1, fr):
     """(1 − fr) p[k0] + fr p[k1]."""
     return (1.0 - fr) * p[k0] + fr * p[k1]
+
+
+@nb.njit(cache=True, inline="always")
+def seakeeping_to_body(w, ctx, cp, sp):
+    """Turn the wrench ``w`` (forces 0–2, moments 3–5) from the seakeeping frame (x along the heading,
+    horizontal; z down) into body axes in place: f_body = Rᵀ Rz(ψ) f, with cos/sin ψ (cp, sp) and the
+    body-to-earth rotation R in ``ctx`` — so that a heeled or trimmed ship is not pushed sideways by a
+    vertical load."""
+    for o in (0, 3):
+        fn = cp * w[o] - sp * w[o + 1]
+        fe = sp * w[o] + cp * w[o + 1]
+        fd = w[o + 2]
+        for k in range(3):
+            w[o + k] = ctx[L.ROT + k] * fn + ctx[L.ROT + 3 + k] * fe + ctx[L.ROT + 6 + k] * fd

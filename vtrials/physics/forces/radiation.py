@@ -29,6 +29,7 @@ import numba as nb
 import numpy as np
 
 from vtrials.physics.forces import context as L
+from vtrials.physics.forces._wavetable import seakeeping_to_body
 from vtrials.physics.forces.registry import register
 
 
@@ -89,14 +90,7 @@ def radiation_kernel(p, s, env, ctx, aux, w):
         w[int(p[2 + r])] = -acc
     # seakeeping frame (x along the heading, horizontal; z down) → body axes: f_body = Rᵀ Rz(ψ) f
     psi = ctx[L.EUL + 2]
-    cp = math.cos(psi)
-    sp = math.sin(psi)
-    for o in (0, 3):
-        fn = cp * w[o] - sp * w[o + 1]
-        fe = sp * w[o] + cp * w[o + 1]
-        fd = w[o + 2]
-        for k in range(3):
-            w[o + k] = ctx[L.ROT + k] * fn + ctx[L.ROT + 3 + k] * fe + ctx[L.ROT + 6 + k] * fd
+    seakeeping_to_body(w, ctx, math.cos(psi), math.sin(psi))
 
 
 RADIATION_COMPONENT = register("radiation", radiation_kernel)

@@ -27,7 +27,7 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.physics.forces import context as L
-from vtrials.physics.forces._wavetable import heading_fold, lerp
+from vtrials.physics.forces._wavetable import heading_fold, lerp, seakeeping_to_body
 from vtrials.physics.forces.registry import register
 
 HEAD = 8
@@ -117,14 +117,8 @@ def excitation_kernel(p, s, env, ctx, aux, w):
     w[5] = f5
     for d in range(6):
         w[d] *= p[2 + d]
-    # the sums are in the seakeeping frame (x along the heading, horizontal; z down): to body axes,
-    # f_body = Rᵀ Rz(ψ) f, so that a heeled or trimmed ship is not pushed sideways by a vertical load
-    for o in (0, 3):
-        fn = cp * w[o] - sp * w[o + 1]
-        fe = sp * w[o] + cp * w[o + 1]
-        fd = w[o + 2]
-        for k in range(3):
-            w[o + k] = ctx[L.ROT + k] * fn + ctx[L.ROT + 3 + k] * fe + ctx[L.ROT + 6 + k] * fd
+    # the sums are in the seakeeping frame (x along the heading, horizontal; z down): to body axes
+    seakeeping_to_body(w, ctx, cp, sp)
 
 
 WAVE_EXCITATION_COMPONENT = register("wave_excitation", excitation_kernel)
