@@ -131,3 +131,49 @@ def test_coverage_summary_is_consistent_with_the_rows(serial):
             inside = t["lo95"][i] <= t["truth"][i] <= t["hi95"][i]
             assert inside == t["covered"][i] or math.isclose(t["lo95"][i], t["truth"][i]) or \
                 math.isclose(t["hi95"][i], t["truth"][i])
+
+
+def _children(pid: int) -> list[int]:
+    out = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                stat = (d / "stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                out.append(int(d.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_workers_end_with_a_killed_campaign(tmp_path):
+    """A campaign process killed outright (SIGKILL: no cleanup runs) takes its spawn workers with it
+    (Linux parent-death signal), instead of leaving them to finish their replicates for nothing."""
+    import subprocess
+    import sys
+    import time
+    p = subprocess.Popen([sys.executable, "-m", "vtrials.cli", "campaign", str(SCN), "--replicates", "3",
+                          "--workers", "1", "--quiet", "--out", str(tmp_path / "c")],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers = []
+    t0 = time.monotonic()
+    while not workers and time.monotonic() - t0 < 120 and p.poll() is None:
+        time.sleep(0.2)
+        workers = [c for c in _children(p.pid)
+                   if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
+    assert workers, "no worker process seen"
+    time.sleep(1.0)  # the worker is importing / running its replicate
+    p.kill()
+    p.wait()
+    t0 = time.monotonic()
+    while any(_alive(w) for w in workers) and time.monotonic() - t0 < 30:
+        time.sleep(0.2)
+    assert not any(_alive(w) for w in workers)

@@ -129,10 +129,22 @@ def release_memory() -> None:
         pass
 
 
+def _die_with_parent() -> None:
+    """Worker initializer: on Linux, ask the kernel to end this worker when the campaign process dies
+    (prctl PR_SET_PDEATHSIG = 1, SIGTERM). A campaign killed with SIGTERM/SIGKILL otherwise left its
+    spawn workers running their replicates to the end for nothing (one ran on for 45 min); with
+    ``--resume`` those replicates are redone anyway. Elsewhere a no-op."""
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 15, 0, 0, 0)
+    except (OSError, AttributeError):
+        pass
+
+
 def default_executor(workers: int | None = None) -> cf.Executor:
-    """A process pool started with 'spawn' (safe with MuJoCo's and numba's threads)."""
+    """A process pool started with 'spawn' (safe with MuJoCo's and numba's threads), whose workers end
+    with the campaign process."""
     return cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
-                                  mp_context=multiprocessing.get_context("spawn"))
+                                  mp_context=multiprocessing.get_context("spawn"), initializer=_die_with_parent)
 
 
 def _write_json_atomic(path: Path, obj) -> None:
