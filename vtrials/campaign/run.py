@@ -23,6 +23,8 @@ Any :class:`concurrent.futures.Executor` runs it: a spawn process pool by defaul
 from __future__ import annotations
 
 import concurrent.futures as cf
+import ctypes
+import gc
 import json
 import math
 import multiprocessing
@@ -107,8 +109,24 @@ def run_replicate(path: str, index: int, campaign_seed: int, n_total: int, keep_
             if dest.exists():
                 shutil.rmtree(dest)
             shutil.copytree(tmp, dest)
-    return {"replicate": index, "drawn": drawn, "rows": rows_of(out, index),
-            "simulated_time_s": out.get("simulated_time_s"), "timings": out.get("timings")}
+    row = {"replicate": index, "drawn": drawn, "rows": rows_of(out, index),
+           "simulated_time_s": out.get("simulated_time_s"), "timings": out.get("timings")}
+    del res, out
+    release_memory()
+    return row
+
+
+def release_memory() -> None:
+    """Hand a finished replicate's memory back to the system. A replicate's day peaks at 1–2.3 GB of
+    arrays (KVLCC2's IMO day); glibc keeps freed blocks below its (self-raising) mmap threshold in the
+    heap, so a worker's resident size ratcheted up over replicates — 8.4 GB after 20 KVLCC2 replicates,
+    and a worker was killed out of memory. After each replicate: collect cycles, then ``malloc_trim``
+    (glibc; elsewhere a no-op). Measured on 4 KVLCC2 IMO replicates: 1.1–2.2 GB → 0.36 GB each time."""
+    gc.collect()
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
 
 
 def default_executor(workers: int | None = None) -> cf.Executor:
