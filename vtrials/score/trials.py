@@ -189,7 +189,7 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
         cals[inst] = {"intercept": _cmp(cal["intercept"], a), "slope": _cmp(cal["slope"], b),
                       "true_line": {"intercept_mps": a, "slope": b},
                       "line_error_at_points_kn": (line_err / KNOT).tolist(),
-                      "true_breakaway_mps": dev.v_break}
+                      "true_breakaway_mps": getattr(dev, "v_break", None)}
     cover = [x["stw"]["covered"] for x in legs if x["stw"]["covered"] is not None]
     errs = [abs(x["stw_error_kn"]) for x in legs if x["stw_error_kn"] is not None]
     summary = {"legs": len(legs), "max_abs_stw_error_kn": max(errs) if errs else None,
