@@ -692,6 +692,9 @@ def reduce_log_calibration(rec: Record) -> dict:
         jf = _joint_current_fit(t, hd + drift, vg, vs, grp, fit["order"], reading=reading)
         b, C = jf["x"][:2], jf["cov"][:2, :2]
         sd = np.sqrt(np.diag(C))
+        # dof of each coefficient: Welch–Satterthwaite, the τ part (found from the fit's residuals) on the
+        # fit's dof — the EM log's 300-s wander makes τ the larger part, estimated from 8–10 dof
+        nu = [CUR.scatter_budget(jf["A"][k], vs, jf["tau"], np.zeros(vs.size), jf["dof"])[1] for k in (0, 1)]
         se = np.sqrt(np.maximum(C[0, 0] + 2.0 * xs * C[0, 1] + xs ** 2 * C[1, 1], 0.0))
         line = b[0] + b[1] * xs
         fitted = b[0] + b[1] * xr
@@ -700,8 +703,8 @@ def reduce_log_calibration(rec: Record) -> dict:
         calibrations[name] = {
             "method": "line solved inside the joint current fit, one speed through water per leg from its "
                       "reading (legs weighed by their tracking σ and the scatter τ beyond it)",
-            "intercept": _est(Estimate(float(b[0]), float(sd[0]))),
-            "slope": _est(Estimate(float(b[1]), float(sd[1]))),
+            "intercept": _est(Estimate(float(b[0]), float(sd[0]), nu[0])),
+            "slope": _est(Estimate(float(b[1]), float(sd[1]), nu[1])),
             "correlation": float(C[0, 1] / (sd[0] * sd[1])),
             "r2": 1.0 - ss_res / ss_tot if ss_tot > 0 else None,
             "see": float(np.sqrt(np.sum(jf["residuals"] ** 2) / jf["dof"])),
