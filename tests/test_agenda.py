@@ -7,6 +7,7 @@ import json
 import math
 
 import numpy as np
+from scipy import stats
 import pytest
 
 from tests.calibration import drawn_meter_errors, net_of_calibration
@@ -258,17 +259,27 @@ def log_calibration(tmp_path_factory, scenarios_dir):
 
 
 def test_log_calibration_speed_through_water_per_leg(log_calibration):
-    """Each leg's speed through water (the group's, from the joint current fit) within 0.1 kn of, and its
-    95 % interval covering, the mean of the group's true leg speeds; the legs' own true speeds spread
-    about that mean by less than 0.05 kn (head and tail wind)."""
+    """Each leg's speed through water (the group's, from the joint current fit) within 0.1 kn of the mean
+    of the group's true leg speeds; the legs' own true speeds spread about that mean by less than
+    0.05 kn (head and tail wind). The groups' 95 % intervals: on one day six calibrated intervals all
+    cover only 0.95⁶ = 74 % of the time (less independent still: the groups share the current's
+    polynomial), so one day is checked for consistency, not coverage — no group off by more than 1.5
+    half-widths (|z| > 2.94: 0.3 % per group), and Σ z² over the groups below the 99.9 % point of
+    χ²(6). Their coverage is measured where it can be, over a campaign
+    (benchmarks/results/campaign_patrol51_log_calibration_200.json)."""
     tr = log_calibration["trials"][0]
     for leg in tr["error"]["legs"]:
         assert abs(leg["stw_leg_truth"] - leg["stw"]["truth"]) < 0.05 * KNOT, leg
     legs = tr["error"]["legs"]
     assert len(legs) == 16
+    z = {}
     for leg in legs:
         assert abs(leg["stw_error_kn"]) < 0.1, leg
-        assert leg["stw"]["covered"], leg
+        c = leg["stw"]
+        z[leg["group"]] = (c["reduced"] - c["truth"]) / (0.5 * (c["hi95"] - c["lo95"]) / 1.959964)
+        assert abs(z[leg["group"]]) <= 1.5 * 1.959964, leg
+    assert len(z) == 6
+    assert sum(v * v for v in z.values()) < stats.chi2.ppf(0.999, len(z)), z
 
 
 def test_log_calibration_recovers_the_knotmeter(log_calibration):
@@ -278,7 +289,11 @@ def test_log_calibration_recovers_the_knotmeter(log_calibration):
     # the reduced line is within 0.05 kn of the true one over the calibrated range
     assert max(abs(x) for x in cal["line_error_at_points_kn"]) < 0.05
     red = tr["reduced"]["calibrations"]["knotmeter"]
-    assert red["r2"] > 0.999 and red["dof"] == red["n"] - 2
+    # the line is solved inside the joint current fit: its dof are the legs' less its parameters (the line,
+    # a speed per group without readings, the current's polynomial)
+    assert red["r2"] > 0.999 and red["dof"] == red["legs_in_fit"] - len(red["parameters"]) >= 3
+    assert red["parameters"][:2] == ["intercept", "slope"]
+    assert tr["reduced"]["drift_angle"]["source"].startswith("doppler")
 
 
 @pytest.fixture(scope="module")

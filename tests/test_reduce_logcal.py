@@ -191,3 +191,81 @@ def test_smoothing_study_periodic_variation_attenuation():
     expect = np.abs(np.sin(st.k * math.pi * dt / T) / (st.k * np.sin(math.pi * dt / T)))
     assert np.allclose(st.std / st.std[0], expect, atol=2e-3)
     assert expect[2] == pytest.approx(2.0 / 3.0) and expect[3] < 1e-12
+
+
+# ------------------------------------------------------------ the log's line inside the current fit
+def _synthetic_day(rng, drift_deg_at_5kn=3.0):
+    """A log-calibration day like scenarios/patrol51_log_calibration*.toml: four-leg sets at 5 and 10 kn,
+    reciprocal pairs at 15–30 kn, 10 min apart; a 1.2 kn current turning with a tide (quadratic in
+    time over the day); leeway in a steady wind (drift angle ∝ its beam component over U²); each
+    leg's own speed through water off its group's by a few mm/s (head/tail wind); a log reading each
+    leg's speed through its line plus a little reading noise; ground speeds from tracking, σ = 9 mm/s."""
+    speeds = [5, 10, 15, 20, 25, 30]
+    legs = []
+    for g, v in enumerate(speeds):
+        courses = (10, 100, 190, 280) if g < 2 else (10, 190)
+        legs += [(g, v * KNOT, math.radians(c)) for c in courses]
+    n = len(legs)
+    t = 600.0 * np.arange(n)
+    grp = [x[0] for x in legs]
+    course = np.array([x[2] for x in legs])
+    U = np.array([x[1] for x in legs]) + rng.normal(0.0, 0.005, n)
+    wind_from = rng.uniform(0, 2 * math.pi)  # leeway away from the wind, ∝ its beam component / U²
+    beta = -np.radians(drift_deg_at_5kn) * (5 * KNOT / U) ** 2 * np.sin(wind_from - course)
+    cdir = rng.uniform(0, 2 * math.pi)
+    tt = (t - t.mean()) / 3600.0
+    cmag = 1.2 * KNOT + 0.04 * tt - 0.02 * tt ** 2
+    cn, ce = cmag * math.cos(cdir), cmag * math.sin(cdir)
+    psi = course + beta
+    vg_true = np.hypot(U * np.cos(psi) + cn, U * np.sin(psi) + ce)
+    sig = np.full(n, 0.009)
+    vg = vg_true + rng.normal(0.0, 1.0, n) * sig
+    a, b = 0.15, 1.03
+    reading = (U - a) / b + rng.normal(0.0, 0.002, n)
+    return t, course, beta, vg, sig, grp, reading, a, b
+
+
+def test_log_line_inside_the_current_fit_covers_and_needs_the_drift_angle():
+    """The knotmeter's line solved inside the joint current fit (quadratic current, water tracks along
+    course + drift angle): over 200 synthetic days its 95 % intervals cover the true intercept and
+    slope 0.92–0.98 of the time and are about as wide as the errors (sharpness 0.75–1.4); leaving the
+    leeway out (water track along the course) biases the intercept by several of its standard errors."""
+    from vtrials.reduce.trials import _joint_current_fit
+    rng = np.random.default_rng(2000)
+    z = {"intercept": [], "slope": []}
+    err_drift, err_nodrift = [], []
+    for _ in range(200):
+        t, course, beta, vg, sig, grp, reading, a, b = _synthetic_day(rng)
+        f = _joint_current_fit(t, course + beta, vg, sig, grp, 2, reading=reading)
+        assert f["names"][:2] == ["intercept", "slope"] and f["dof"] == vg.size - 2 - 6
+        sd = np.sqrt(np.diag(f["cov"]))
+        z["intercept"].append((f["x"][0] - a) / sd[0])
+        z["slope"].append((f["x"][1] - b) / sd[1])
+        err_drift.append(f["x"][0] - a)
+        f0 = _joint_current_fit(t, course, vg, sig, grp, 2, reading=reading)
+        err_nodrift.append(f0["x"][0] - a)
+    for k, v in z.items():
+        v = np.abs(np.array(v))
+        cover = np.mean(v <= 1.96)
+        sharp = 1.96 / np.quantile(v, 0.95)
+        assert 0.92 <= cover <= 0.98 and 0.75 <= sharp <= 1.4, (k, cover, sharp)
+    rms_d = float(np.sqrt(np.mean(np.square(err_drift))))
+    rms_n = float(np.sqrt(np.mean(np.square(err_nodrift))))
+    assert rms_n > 1.5 * rms_d, (rms_n, rms_d)
+
+
+def test_group_fit_without_readings_matches_the_line_fit_speeds():
+    """Without readings the same fit gives one speed per group; on noise-free legs with equal speeds in
+    a group, no drift and a quadratic current, it returns the true speeds and current exactly."""
+    from vtrials.reduce.trials import _joint_current_fit
+    rng = np.random.default_rng(1)
+    t, course, beta, vg, sig, grp, reading, a, b = _synthetic_day(rng, drift_deg_at_5kn=0.0)
+    Ug = np.array([5, 10, 15, 20, 25, 30]) * KNOT
+    U = Ug[grp]
+    cn = 0.3 + 1e-5 * (t - t.mean()) + 2e-9 * (t - t.mean()) ** 2
+    ce = -0.4 + 2e-5 * (t - t.mean())
+    vg = np.hypot(U * np.cos(course) + cn, U * np.sin(course) + ce)
+    f = _joint_current_fit(t, course, vg, sig, grp, 2)
+    assert f["groups"] == list(range(6)) and f["tau"] == 0.0
+    np.testing.assert_allclose(f["x"][:6], Ug, atol=1e-9)
+    np.testing.assert_allclose(f["x"][6:], [0.3, -0.4, 1e-5, 2e-5, 2e-9, 0.0], atol=1e-9)

@@ -550,6 +550,16 @@ class EMLog(Device):
     def outputs(self, t, y):
         return {"speed": np.maximum(y, 0.0)}
 
+    def true_calibration(self) -> tuple[float, float]:
+        """(intercept [m/s], slope) of STW = a + b·reading in steady straight flow, upright: the reading is
+        (1 + s)·V cos ε + b₀ (scale error s, then bias b₀, as the chain applies them), so
+        STW = (reading − b₀)/((1 + s) cos ε). The Gauss–Markov wander and the noise are not part of the
+        line (they average over a leg or show as its scatter)."""
+        s = sum(float(np.sum(p.value)) for p in self.chain.parts if isinstance(p, P.ScaleFactor))
+        b0 = sum(float(np.sum(p.value)) for p in self.chain.parts if isinstance(p, P.Bias))
+        k = 1.0 / ((1.0 + s) * math.cos(self.eps))
+        return -b0 * k, k
+
     def drawn(self):
         return {"misalignment_rad": self.eps, "heel_sensitivity_per_rad": self.k_heel, "chain": self.chain.drawn()}
 

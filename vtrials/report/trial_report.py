@@ -189,7 +189,8 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
          f"Tracking: `{red['tracking']}`. Legs: {sm['legs']}. Largest speed-through-water error "
          f"{_fmt(sm['max_abs_stw_error_kn'], 3)} kn; 95 % intervals cover the truth on "
          f"{_fmt(_pct(sm['stw_coverage']), 0)} % of legs; current error ≤ "
-         f"{_fmt(sm['max_current_error_kn'], 3)} kn.", ""]
+         f"{_fmt(sm['max_current_error_kn'], 3)} kn."
+         + (f" Drift angle of the water track: {red['drift_angle']['source']}." if "drift_angle" in red else ""), ""]
     for u in red.get("under_determined", []):
         L += [f"**Not reduced — {u['quantity']} is under-determined**: {u['why']}.", ""]
     L += [f"![{f}]({f})" for f in figs] + [""]
@@ -199,8 +200,12 @@ def _lc_markdown(tr: dict, figs: list[str]) -> list[str]:
             continue
         e = err["calibrations"].get(inst)
         L += [f"**{inst}**: STW = {_fmt(cal['intercept']['value'] / KNOT, 3)} kn (± {_fmt(cal['intercept']['std'] / KNOT, 3)}) + "
-              f"{_fmt(cal['slope']['value'], 4)} (± {_fmt(cal['slope']['std'], 4)}) × reading; r² = {cal['r2']:.5f}, "
-              f"SEE = {_fmt(cal['see'] / KNOT, 3)} kn (residual RMS), reduced χ² = {_fmt(cal.get('chi2_red'), 2)}, n = {cal['n']}"
+              f"{_fmt(cal['slope']['value'], 4)} (± {_fmt(cal['slope']['std'], 4)}) × reading; r² = {_fmt(cal['r2'], 5)}, "
+              + (f"SEE = {_fmt(cal['see'] / KNOT, 3)} kn (legs' ground-speed residuals of the joint fit), scatter "
+                 f"beyond the tracking σ τ = {_fmt(cal['scatter_tau'] / KNOT, 3)} kn, {cal['n']} legs with readings, "
+                 f"dof {cal['dof']}" if "scatter_tau" in cal else
+                 f"SEE = {_fmt(cal['see'] / KNOT, 3)} kn (residual RMS), reduced χ² = {_fmt(cal.get('chi2_red'), 2)}, "
+                 f"n = {cal['n']}")
               + (f"; true: {_fmt(e['true_line']['intercept_mps'] / KNOT, 3)} kn + {_fmt(e['true_line']['slope'], 4)} × reading "
                  f"(intercept covered: {e['intercept']['covered']}, slope covered: {e['slope']['covered']})" if e else ""), ""]
     L += ["| run | group | course | V_G [kn] | STW [kn] | ± (95 %) | true STW [kn] | err [kn] | covered |",

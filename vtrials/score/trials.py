@@ -173,8 +173,9 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
     cur_err = []
     for leg in ([] if "under_determined" in cur else reduced["legs"]):  # an unresolved current has no error
         tr = truth[leg["run"]]
-        cn = cur["north"]["value"] + (cur["north_rate"]["value"] * (leg["t_mid"] - tref) if cur["trend"] else 0.0)
-        ce = cur["east"]["value"] + (cur["east_rate"]["value"] * (leg["t_mid"] - tref) if cur["trend"] else 0.0)
+        dt = leg["t_mid"] - tref
+        cn, ce = (cur[c]["value"] + sum(cur[f"{c}_{k}"]["value"] * dt ** p for p, k in ((1, "rate"), (2, "accel"))
+                                        if f"{c}_{k}" in cur) for c in ("north", "east"))
         cur_err.append({"run": leg["run"], "reduced": [cn, ce], "truth": [tr["current_n"], tr["current_e"]],
                         "error_mps": math.hypot(cn - tr["current_n"], ce - tr["current_e"])})
     cals = {}
@@ -188,7 +189,7 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
         cals[inst] = {"intercept": _cmp(cal["intercept"], a), "slope": _cmp(cal["slope"], b),
                       "true_line": {"intercept_mps": a, "slope": b},
                       "line_error_at_points_kn": (line_err / KNOT).tolist(),
-                      "true_breakaway_mps": dev.v_break}
+                      "true_breakaway_mps": getattr(dev, "v_break", None)}
     cover = [x["stw"]["covered"] for x in legs if x["stw"]["covered"] is not None]
     errs = [abs(x["stw_error_kn"]) for x in legs if x["stw_error_kn"] is not None]
     summary = {"legs": len(legs), "max_abs_stw_error_kn": max(errs) if errs else None,
