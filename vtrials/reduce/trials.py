@@ -621,7 +621,7 @@ def reduce_log_calibration(rec: Record) -> dict:
     grp = [r["group"] for r in runs]
     vs = np.array([r["vg"].std for r in runs])
     drift, drift_source = _leg_drift(runs, kinds)
-    groups, U, cur, fit, under = resolve_current(t, hd + drift, vg, vs, grp)
+    groups, U, cur, fit, under = resolve_current(t, hd, vg, vs, grp, drift=drift)
     dof, resid = fit["dof"], fit["residuals"]
     # classic cross-checks per group: the four-leg closed form and the reciprocal-pair shortcut
     classic = {}
@@ -741,7 +741,7 @@ def reduce_log_calibration(rec: Record) -> dict:
     return out
 
 
-def resolve_current(t, heading, vg, vg_std, group):
+def resolve_current(t, heading, vg, vg_std, group, drift=None):
     """Speed through water per group and the current from the legs' ground speeds, or the reason they
     cannot be resolved.
 
@@ -754,7 +754,8 @@ def resolve_current(t, heading, vg, vg_std, group):
     through water falls back to the classic per-group estimate that needs no current: the mean of a
     reciprocal pair's ground speeds (the along-axis current cancels; seed 000 eq. 3), or the four-leg
     closed form (seed 000 App. A); a group with neither is under-determined too. ``heading`` is each
-    leg's water-track direction (course plus drift angle).
+    leg's course, which sets the geometry (the axes and the rank); ``drift`` [rad] its measured drift
+    angle, so that the fit takes the water track along heading + drift.
 
     Returns (groups, U {group: Estimate | None}, current dict, fit dict, under-determined list).
     """
@@ -780,7 +781,8 @@ def resolve_current(t, heading, vg, vg_std, group):
     p = G + 2 * (order + 1)
     rank = int(np.linalg.matrix_rank(design(order)))
     if n > p and rank == p:
-        f = _joint_current_fit(t, heading, vg, vg_std, group, order)
+        track = heading if drift is None else heading + np.asarray(drift, dtype=float)
+        f = _joint_current_fit(t, track, vg, vg_std, group, order)
         x, cov, dof, tau = f["x"], f["cov"], f["dof"], f["tau"]
         sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
         # the groups' speeds carry τ in full (normal quantile): τ stands for the ship's leg-to-leg scatter
