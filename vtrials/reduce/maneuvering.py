@@ -192,21 +192,30 @@ class DriftLine:
         self.own = np.array([[d.north.std, d.east.std] for d in drifts])
         self.coef, self.A_inv, self.s2, self.tau, dof = self._fit(A, v)
         self.line = line
-        self.dof = max(dof, 1)
+        self.dof = dof
         self.side = None
         if sides is not None:
             sd = np.asarray(sides, float)
             As = np.column_stack([A, sd])
-            if np.any(sd > 0) and np.any(sd < 0) and n - As.shape[1] >= 2 and np.linalg.matrix_rank(As) == As.shape[1]:
+            if np.any(sd > 0) and np.any(sd < 0) and n >= As.shape[1] and np.linalg.matrix_rank(As) == As.shape[1]:
                 self.side = self._fit(As, v)
 
     def _fit(self, A, v):
         coef, *_ = np.linalg.lstsq(A, v, rcond=None)
         res = v - A @ coef
         dof = v.shape[0] - A.shape[1]
-        s2 = np.sum(res ** 2, axis=0) / dof if dof > 0 else np.mean(self.own ** 2, axis=0)
+        own2 = np.mean(self.own ** 2, axis=0)
+        s2 = np.sum(res ** 2, axis=0) / dof if dof > 0 else own2
         # scatter beyond the circles' own noise: the wind's push and anything else the fit misses
-        tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - np.mean(self.own ** 2, axis=0), 0.0)))
+        tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - own2, 0.0)))
+        if dof < 2:
+            # below two residual degrees of freedom the scatter cannot stand for the noise (one circle
+            # per side: the side term takes the whole difference, dof 0; with one dof a t interval is
+            # 12.7 standard errors wide): the circles' own standard errors plus τ give the variance,
+            # with a normal interval (measured on the KVLCC2 campaign, one 35° circle per side: the
+            # residual-scatter SE made the drift's interval 34-108 times its error's 95 % quantile)
+            s2 = own2 + np.square(tau)
+            dof = 0
         return coef, np.linalg.pinv(A.T @ A), s2, tau, dof
 
     def _at(self, fit, a, tau_count: float) -> tuple[Estimate, Estimate]:
@@ -215,7 +224,7 @@ class DriftLine:
         out = []
         for ax in range(2):
             var = float(a @ A_inv @ a) * s2[ax] + tau_count * tau[ax] ** 2
-            out.append(Estimate(float(val[ax]), math.sqrt(var), max(dof, 1)))
+            out.append(Estimate(float(val[ax]), math.sqrt(var), dof if dof >= 2 else None))
         return out[0], out[1]
 
     def __call__(self, t: float) -> tuple[Estimate, Estimate]:
