@@ -848,6 +848,15 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
     if np.count_nonzero(ma) < 3:
         raise ValueError("no approach heading data before EXECUTE")
     psi0, psi0_se = _circ_mean(psi[ma])
+    # the references measure from the heading at the instant of EXECUTE; the approach course is the
+    # mean over the approach, so the ship's yaw about it (the autopilot in gusts: its scatter beyond the
+    # gyro's own noise) is an error of the axes and of the heading marks alike
+    dev0 = np.angle(np.exp(1j * (psi[ma] - psi0)))
+    yaw_var = max(float(np.var(dev0, ddof=1)) - sig_psi ** 2, 0.0) if dev0.size > 2 else 0.0
+    # the axes also turn with the gyro's slow error (bias and wander: ``heading_sd``), which the
+    # heading-change marks do not see (a turn of 0.17° moves a 900-m advance's transfer by 2.7 m)
+    psi_axis_sd = math.sqrt(psi0_se ** 2 + yaw_var + heading_sd ** 2)
+    psi_mark_sd = math.sqrt(psi0_se ** 2 + yaw_var)
     psi0 = psi0 + TWO_PI * round((float(np.mean(psi[ma])) - psi0) / TWO_PI)  # same branch as record
     mp = (tp >= t_execute - approach_s) & (tp <= t_execute)
     if np.count_nonzero(mp) < 3:
@@ -931,7 +940,9 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
             return sum(2.0 * sd ** 2 * (1.0 - math.exp(-abs(dt) / tau)) for sd, tau in fix_errors if tau > 0.0)
         return 2.0 * sigma_fix ** 2
 
-    def position_at(tq, t_se):
+    arm_h = math.hypot(float(lever_arm[0]), float(lever_arm[1])) if lever_arm is not None else 0.0
+
+    def position_at(tq, t_se, dpsi_mark=0.0):
         """Corrected position at tq (local cubic over ±mark_window_deg of heading), velocity, and the
         2×2 covariance of (P(tq) − P_execute) from noise, the time SE, and drift."""
         hw = max(4 * float(np.median(np.diff(tp))), math.radians(mark_window_deg) / max(r_guess, 1e-6))
@@ -944,13 +955,17 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         C = np.diag([varN + var_PeN, varE + var_PeE]) + (t_se ** 2 + 2.0 * timing_sd ** 2) * np.outer(vel, vel) \
             + timing_sd ** 2 * np.outer(v_app, v_app) \
             + (tq - t_execute) ** 2 * Sd + mark_fix_var(tq - t_execute) * np.eye(2)
+        # the fixes were moved from the antenna along the gyro heading: its slow error turns the lever
+        # arm alike at EXECUTE and at the mark, which moves their difference by δψ·|arm|·2 sin(Δψ/2)
+        # (direction turning with the heading: half of it per axis)
+        C = C + 0.5 * (heading_sd * arm_h * 2.0 * math.sin(0.5 * dpsi_mark)) ** 2 * np.eye(2)
         return np.array([vN - PeN, vE - PeE]), vel, C
 
     def project(dP, C):
         along = float(dP @ u)
         across = side * float(dP @ nvec)
-        va = float(u @ C @ u) + (across * psi0_se) ** 2
-        vc = float(nvec @ C @ nvec) + (along * psi0_se) ** 2
+        va = float(u @ C @ u) + (across * psi_axis_sd) ** 2
+        vc = float(nvec @ C @ nvec) + (along * psi_axis_sd) ** 2
         return along, math.sqrt(va), across, math.sqrt(vc)
 
     for deg_mark in (10.0, 90.0, 180.0):
@@ -959,11 +974,11 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
             notes.append(f"heading change never reached {deg_mark:.0f} deg")
             continue
         tq, tse, slope = mk
-        tse = math.hypot(tse, psi0_se / max(abs(slope), 1e-12))  # approach-course error shifts the mark
+        tse = math.hypot(tse, psi_mark_sd / max(abs(slope), 1e-12))  # approach-course error shifts the mark
         if tq > tp[-1] or tq < tp[0]:
             notes.append(f"no tracking data at the {deg_mark:.0f} deg mark")
             continue
-        dP, vel, C = position_at(tq, tse)
+        dP, vel, C = position_at(tq, tse, math.radians(deg_mark))
         along, sa, across, sc = project(dP, C)
         tm_est = Estimate(tq - t_execute, tse)
         if deg_mark == 10.0:
