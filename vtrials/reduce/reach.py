@@ -800,7 +800,14 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         a90 = abs(base.get("a90", 0.0))
         extra = lvl / a90 ** 2 if a90 > 0.0 else 0.0
         res.time_to_90_percent = Estimate(base["t90"] - t_execute, math.sqrt(bstd("t90") ** 2 + extra + timing_sd ** 2))
-    if water is not None:
+    # the log or the ground track: the speed through the water from the fixes carries the current's
+    # error (whole, where the heading swings, as in a crash stop), the log's its scale error (and for
+    # the crossings, whose levels are fractions of the log's own speeds, not even that): the log is
+    # taken when the current is the less certain of the two at the run's largest speed (KVLCC2's
+    # current from one approach course: 0.05-0.1 m/s against the log's 0.04; the patrol vessel's:
+    # 0.02-0.04 against 0.06-0.08 — there the receiver's Doppler crosses its levels more sharply)
+    use_log = water is not None and math.sqrt(float(np.trace(SD))) > float(water[3]) * max(abs(U0), abs(base["UT"]))
+    if use_log:
         _water_track_instants(res, base, tg, water, t_execute, t_end, approach_s, U0_along, timing_sd, notes,
                               band_fraction, tail_fraction, psi0_se, SD, uvec, nvec, bstd)
     Ug = np.array(Ug) if Ug else np.zeros((0, len(tg)))

@@ -793,10 +793,12 @@ def drift_over_loop(t, north, east, loop: SteadyLoop, *, mark_window_deg: float 
     d = np.array([a @ n_, a @ e_])
     var_w = np.array(sigma) ** 2 * float(a @ a)
     var_c = correlated_variance(t, a, fix_errors)
-    cov = np.diag(var_w + var_c) + (loop.start_std ** 2 * np.outer(vel[0], vel[0])
-                                    + loop.end_std ** 2 * np.outer(vel[1], vel[1])) / T ** 2
+    cov_t = (loop.start_std ** 2 * np.outer(vel[0], vel[0]) + loop.end_std ** 2 * np.outer(vel[1], vel[1])) / T ** 2
+    cov = np.diag(var_w + var_c) + cov_t
+    # the fixes' weights (for a functional that also uses these fixes: the loop's circle)
     return Drift(Estimate(float(d[0]), math.sqrt(cov[0, 0])), Estimate(float(d[1]), math.sqrt(cov[1, 1])), cov,
-                 "loop", 0, {"loop_s": [loop.t_start, loop.t_end], "full_loop": loop.full})
+                 "loop", 0, {"loop_s": [loop.t_start, loop.t_end], "full_loop": loop.full, "weights": a,
+                             "t_first": float(t[0]), "cov_timing": cov_t})
 
 
 def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None, roll=None, t_roll=None,
@@ -1024,16 +1026,30 @@ def turning_metrics(t, north, east, heading, t_execute: float, *, t_heading=None
         # solution): white tracking noise σ_p and the tracking's time-correlated errors; the fit's own
         # residual scatter would also count the wind's non-circularity of the loop, which the
         # reference shares
-        h, theta_k = _circle_radius_weights(Nl[ms], El[ms], p)
-        varR = 0.5 * (sigN ** 2 + sigE ** 2) * float(h @ h) + correlated_variance(tp[ms], h, fix_errors, theta_k)
+        hR, theta_k = _circle_radius_weights(Nl[ms], El[ms], p)
+        g = np.zeros(2)
         if ld is not None and np.any(Sl > 0):
-            g = np.zeros(2)
             for j in range(2):
-                h = 1e-4
+                eps = 1e-4
                 dd = ld.vector.copy()
-                dd[j] += h
+                dd[j] += eps
                 N2, E2 = drift_corrected_track(tp[ms], N[ms], E[ms], t_execute, tuple(dd))
-                g[j] = (fit_circle(N2, E2)[0][2] - R) / h
+                g[j] = (fit_circle(N2, E2)[0][2] - R) / eps
+        aw = ld.detail.get("weights") if ld is not None else None
+        if aw is not None and len(aw) == tp.size and ld.detail.get("t_first") == float(tp[0]):
+            # the loop's own drift comes from the same fixes (its two ends): the radius is one linear
+            # functional of every fix's north and east error, through the fit (radial weights h) and
+            # through the drift (weights a, mapped by ∂R/∂d) — taken as one, so that an error common
+            # to the loop's ends and the circle (the tracking's slow wander) is not counted twice
+            wN, wE = g[0] * np.asarray(aw, float), g[1] * np.asarray(aw, float)
+            idx = np.flatnonzero(ms)
+            wN[idx] += hR * np.cos(theta_k)
+            wE[idx] += hR * np.sin(theta_k)
+            varR = sigN ** 2 * float(wN @ wN) + sigE ** 2 * float(wE @ wE) \
+                + correlated_variance(tp, wN, fix_errors) + correlated_variance(tp, wE, fix_errors) \
+                + float(g @ np.asarray(ld.detail["cov_timing"], float) @ g)
+        else:
+            varR = 0.5 * (sigN ** 2 + sigE ** 2) * float(hR @ hR) + correlated_variance(tp[ms], hR, fix_errors, theta_k)
             varR += float(g @ Sl @ g)
         # drift angle: heading minus the tangent direction of the fitted circle
         theta = np.arctan2(El[ms] - p[1], Nl[ms] - p[0])
