@@ -49,6 +49,11 @@ Method (:func:`reach_analysis`):
      for good (searched up to the start of the tail window, where the speed is U_T by definition);
      the reach and track distance at that instant are reported with it. Also the time to 90 % of
      the speed change (better conditioned than the band entry of an exponential approach).
+   With the receiver's own velocity (GNSS Doppler) the time to terminal speed is where it crosses the
+   band's edge after the 90 % point, and the 90 % instant and dead in the water are found on it too;
+   with a water-track log whose speed through the water is better known than the current the fixes
+   would need (:func:`_water_track_instants`), the speeds and instants through the water come from
+   the log.
 4. Uncertainty: residual bootstrap (default 200 replicates): the residuals of the C_p fits
    (inflated by √(n/(n − edf)) for the shrinkage of fitted residuals) are resampled — i.i.d., or in
    moving blocks of ``block`` samples for time-correlated tracking error — added to the C_p fits, and

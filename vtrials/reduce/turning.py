@@ -37,6 +37,10 @@ MSC/Circ.1053 definitions of advance, transfer and tactical diameter):
    and a steady rate. :func:`drift_from_circle_fit` (circle whose centre translates at constant
    velocity, fitted by least squares with a free phase rate) is an independent cross-check that uses
    all steady samples but assumes a perfectly circular path; it is used only when no pairs exist.
+   The trial reduction (:mod:`vtrials.reduce.maneuvering`) takes each circle's drift over its steady
+   loop instead (``drift='loop'``, :func:`drift_over_loop`: the displacement between the loop's ends,
+   360° of heading apart, over its duration — the references' definition), since the pairs from a
+   steady part that starts within the first loop carry its transient.
 4. Drift-corrected track (:func:`drift_corrected_track`): recorded − drift·(t − t_execute).
 5. Metrics from the corrected track: advance (along ψ₀ from EXECUTE to the 90° heading-change mark),
    transfer (perpendicular, positive toward the turn, at 90°), tactical diameter (perpendicular at
