@@ -82,12 +82,23 @@ class Channels:
             dm = rec.meta(dl)
             self.water_accuracy = (float(dm.get("scale_accuracy", 0.0)), float(dm.get("noise_mps", 0.0)),
                                    float(dm.get("misalignment_accuracy_rad", 0.0)))
+            # the log's sway is the transducer's: move it to the reference point (midship, the point the
+            # references' v_r belongs to) less r·x of its surveyed position (KVLCC2's log 128 m forward
+            # swinging at 0.002 rad/s in a crash stop: 0.26 m/s of sway, 0.1-0.3 m/s of astern speed)
+            x_log = float(np.asarray(dm.get("surveyed_position_m", [0.0, 0.0, 0.0]), float)[0])
+            if x_log != 0.0 and self.heading is not None and self.t_heading.size > 20:
+                rate = np.gradient(np.unwrap(self.heading), self.t_heading)
+                nk = max(1, int(round(5.0 / max(float(np.median(np.diff(self.t_heading))), 1e-6))))
+                rate = np.convolve(rate, np.ones(nk) / nk, "same")
+                self.water[:, 1] = self.water[:, 1] - np.interp(self.t_water, self.t_heading, rate) * x_log
         self.gyro_resolution = float(gm.get("resolution_rad", 0.0))
+        heading_raw = None
+        lat = (rec.team.get("site") or {}).get("latitude_deg")
         if self.heading is not None:
             self.heading = np.unwrap(self.heading)
+            heading_raw = self.heading
             # the gyro's residual speed error, corrected from the team's track, the site latitude and
             # the corrector settings (vtrials/reduce/gyro.py)
-            lat = (rec.team.get("site") or {}).get("latitude_deg")
             if lat is not None and "corrector_speed_mps" in gm:
                 self.heading = GY.correct_heading(self.t_heading, self.heading, self.t, self.north,
                                                   math.radians(float(lat)), float(gm["corrector_speed_mps"]),
@@ -127,6 +138,17 @@ class Channels:
                 dn, de = _horizontal_offset(self.lever_arm, phi, th, psi)
                 vn, ve = vn - np.gradient(dn, tv), ve - np.gradient(de, tv)
             self.velocity = (tv, vn, ve) if tv.size >= 20 else None
+        # for the turns: the speed error corrected with the receiver's own north velocity (Doppler)
+        # rather than the track's 30-s slopes, which lose part of the swing of V_N in a tight turn and
+        # mix in the motion after FINEX at the loop's last mark (measured on the patrol vessel's
+        # tactical day: the steady loop's duration off by up to 0.05 s against a 0.009 s SE at the
+        # 84-s circles, steady rate of turn 82 % covered over 200 replicates)
+        self.heading_turns = self.heading
+        if self.velocity is not None and heading_raw is not None and lat is not None and "corrector_speed_mps" in gm:
+            tv, vn, _ = self.velocity
+            self.heading_turns = GY.correct_heading(self.t_heading, heading_raw, self.t, self.north,
+                                                    math.radians(float(lat)), float(gm["corrector_speed_mps"]),
+                                                    float(gm["corrector_latitude_rad"]), v_north=(tv, vn))
         rud = k.get("rudder", [])
         # the synchros' calibration uncertainty, common to every reading (of the mean of n synchros)
         cal = [float(rec.meta(r).get("calibration_uncertainty_rad", 0.0)) for r in rud]
@@ -144,11 +166,11 @@ class Channels:
         sd, ppm, t_ref = self._clock
         return math.hypot(sd, ppm * 1e-6 * (t - t_ref))
 
-    def window(self, t0: float, t1: float):
+    def window(self, t0: float, t1: float, turn: bool = False):
         m = (self.t >= t0) & (self.t <= t1)
         mh = (self.t_heading >= t0) & (self.t_heading <= t1)
         out = {"t": self.t[m], "north": self.north[m], "east": self.east[m], "t_heading": self.t_heading[mh],
-               "heading": self.heading[mh]}
+               "heading": (self.heading_turns if turn else self.heading)[mh]}
         if self.roll is not None:
             mr = (self.t_roll >= t0) & (self.t_roll <= t1)
             out.update(t_roll=self.t_roll[mr], roll=self.roll[mr])
@@ -192,21 +214,30 @@ class DriftLine:
         self.own = np.array([[d.north.std, d.east.std] for d in drifts])
         self.coef, self.A_inv, self.s2, self.tau, dof = self._fit(A, v)
         self.line = line
-        self.dof = max(dof, 1)
+        self.dof = dof
         self.side = None
         if sides is not None:
             sd = np.asarray(sides, float)
             As = np.column_stack([A, sd])
-            if np.any(sd > 0) and np.any(sd < 0) and n - As.shape[1] >= 2 and np.linalg.matrix_rank(As) == As.shape[1]:
+            if np.any(sd > 0) and np.any(sd < 0) and n >= As.shape[1] and np.linalg.matrix_rank(As) == As.shape[1]:
                 self.side = self._fit(As, v)
 
     def _fit(self, A, v):
         coef, *_ = np.linalg.lstsq(A, v, rcond=None)
         res = v - A @ coef
         dof = v.shape[0] - A.shape[1]
-        s2 = np.sum(res ** 2, axis=0) / dof if dof > 0 else np.mean(self.own ** 2, axis=0)
+        own2 = np.mean(self.own ** 2, axis=0)
+        s2 = np.sum(res ** 2, axis=0) / dof if dof > 0 else own2
         # scatter beyond the circles' own noise: the wind's push and anything else the fit misses
-        tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - np.mean(self.own ** 2, axis=0), 0.0)))
+        tau = tuple(float(x) for x in np.sqrt(np.maximum(s2 - own2, 0.0)))
+        if dof < 2:
+            # below two residual degrees of freedom the scatter cannot stand for the noise (one circle
+            # per side: the side term takes the whole difference, dof 0; with one dof a t interval is
+            # 12.7 standard errors wide): the circles' own standard errors plus τ give the variance,
+            # with a normal interval (measured on the KVLCC2 campaign, one 35° circle per side: the
+            # residual-scatter SE made the drift's interval 34-108 times its error's 95 % quantile)
+            s2 = own2 + np.square(tau)
+            dof = 0
         return coef, np.linalg.pinv(A.T @ A), s2, tau, dof
 
     def _at(self, fit, a, tau_count: float) -> tuple[Estimate, Estimate]:
@@ -215,7 +246,7 @@ class DriftLine:
         out = []
         for ax in range(2):
             var = float(a @ A_inv @ a) * s2[ax] + tau_count * tau[ax] ** 2
-            out.append(Estimate(float(val[ax]), math.sqrt(var), max(dof, 1)))
+            out.append(Estimate(float(val[ax]), math.sqrt(var), dof if dof >= 2 else None))
         return out[0], out[1]
 
     def __call__(self, t: float) -> tuple[Estimate, Estimate]:
@@ -233,6 +264,43 @@ class DriftLine:
             return self._at((self.coef, self.A_inv, self.s2, self.tau, self.dof), a, 0.0)
         a = np.array([1.0, t - self.tm, 0.0]) if self.line else np.array([1.0, 0.0])
         return self._at(self.side, a, 0.0)
+
+
+class LeewayDrift:
+    """The day's drift of the circles as the current plus the circling ship's mean leeway:
+    D(t) = ĉ(t) + L̄, ĉ the current from the water-track log on the straight approaches
+    (:func:`water_track_current`) and L̄ = mean over the circles of (loop drift − ĉ(t_i)).
+
+    Why not a line in time through the circles' drifts (:class:`DriftLine`): each circle's drift holds
+    its own leeway, which depends on the turn (rudder angle and approach speed, not only the side);
+    when an agenda runs its speeds in order of time (the patrol vessel's tactical day: 2/3, standard,
+    full), the line's slope takes up the change of leeway with speed, and the day's drift came out
+    biased by −0.008 m/s early in the day and +0.013 m/s late (20 replicates). The current's change
+    in time is measured by the log instead, and the leeway is averaged over the same turns the
+    reference averages (:func:`vtrials.score.trials.drift_corrected_turns`).
+
+    Error: ĉ(t) − mean ĉ(t_i) (the current's constant error cancels: only its rate's error times
+    t − t̄ is left) plus the mean of the circles' own errors (their loop drifts' covariances / n²)."""
+
+    def __init__(self, current, times, drifts):
+        self.current = current
+        self.t = np.asarray(times, float)
+        c = [current(t)[:2] for t in self.t]
+        lee = np.array([[d.north.value - cn.value, d.east.value - ce.value] for d, (cn, ce) in zip(drifts, c)])
+        self.leeway = lee.mean(axis=0)
+        self.cov_own = sum(np.asarray(d.cov, float) for d in drifts) / len(drifts) ** 2
+
+    def _X(self, t: float) -> np.ndarray:
+        if not self.current.line:
+            return np.eye(2)
+        return np.hstack([np.eye(2), (t - self.current.t_ref) * np.eye(2)])
+
+    def mean_of_sides(self, t: float) -> tuple[Estimate, Estimate]:
+        cn, ce, _ = self.current(t)
+        g = self._X(t) - sum(self._X(ti) for ti in self.t) / self.t.size
+        cov = g @ self.current.cov_coef @ g.T + self.cov_own
+        return (Estimate(cn.value + float(self.leeway[0]), math.sqrt(cov[0, 0])),
+                Estimate(ce.value + float(self.leeway[1]), math.sqrt(cov[1, 1])))
 
 
 def water_track_current(ch: Channels, runs: list[dict], min_window_s: float = 20.0) -> CU.WaterTrackCurrent | None:
@@ -437,16 +505,18 @@ def reduce_maneuvering(rec: Record) -> dict:
     for r in runs:
         if r["maneuver"].get("type") not in ("turn",):
             continue
-        w = ch.window(r["t_comex"] - 5.0, r["t_finex"])
+        w = ch.window(r["t_comex"] - 5.0, r["t_finex"], turn=True)
         approach = r["t_execute"] - r["t_comex"]
         try:
             sw = periodic_steady_window(w["t_heading"], w["heading"], r["t_execute"])
             res = TU.turning_metrics(w["t"], w["north"], w["east"], w["heading"], r["t_execute"],
                                      t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
                                      rudder=w.get("rudder"), t_rudder=w.get("t_rudder"), approach_s=approach,
-                                     steady=sw, current=current_at(r["t_execute"]), roll_bias=ch.roll_bias,
+                                     steady=sw, drift="loop", current=current_at(r["t_execute"]),
+                                     roll_bias=ch.roll_bias,
                                      fix_errors=ch.fix_errors, timing_sd=ch.timing_sd(r["t_execute"]),
-                                     t_finex=r["t_finex"], gyro_drift=ch.gyro_drift)
+                                     t_finex=r["t_finex"], gyro_drift=ch.gyro_drift, lever_arm=ch.lever_arm,
+                                     heading_sd=math.hypot(ch.gyro_bias, ch.gyro_drift[0]))
         except (ValueError, np.linalg.LinAlgError) as exc:
             out_runs.append({"run": r["run"], "type": "turn", "error": str(exc)})
             continue
@@ -463,14 +533,18 @@ def reduce_maneuvering(rec: Record) -> dict:
     # which differs between starboard and port turns; a line through circles of both sides averages
     # that part out, and the scatter about the line (τ) is kept as a drift uncertainty.
     model = drift_model(drift_times, drifts, drift_sides)
-    if model is not None and len(turns) >= 2:
+    day = model
+    loops = [(tt, d) for tt, d in zip(drift_times, drifts) if d.method == "loop"]
+    if current is not None and loops:
+        day = LeewayDrift(current, [x[0] for x in loops], [x[1] for x in loops])
+    if day is not None and len(turns) >= 2:
         for k, d in enumerate(out_runs):
             r, res0 = next((x for x in turns if x[0]["run"] == d["run"]), (None, None))
             if r is None:
                 continue
             tm = 0.5 * (r["t_execute"] + r["t_finex"])
-            dn, de = model.mean_of_sides(tm)
-            w = ch.window(r["t_comex"] - 5.0, r["t_finex"])
+            dn, de = day.mean_of_sides(tm)
+            w = ch.window(r["t_comex"] - 5.0, r["t_finex"], turn=True)
             try:
                 res = TU.turning_metrics(w["t"], w["north"], w["east"], w["heading"], r["t_execute"],
                                          t_heading=w["t_heading"], roll=w.get("roll"), t_roll=w.get("t_roll"),
@@ -479,13 +553,15 @@ def reduce_maneuvering(rec: Record) -> dict:
                                          sigma_fix=ch.sigma_fix, current=current_at(r["t_execute"]),
                                          roll_bias=ch.roll_bias, fix_errors=ch.fix_errors,
                                          timing_sd=ch.timing_sd(r["t_execute"]), t_finex=r["t_finex"],
-                                         gyro_drift=ch.gyro_drift, loop_drift=res0.drift)
+                                         gyro_drift=ch.gyro_drift, loop_drift=res0.drift,
+                                         lever_arm=ch.lever_arm, heading_sd=math.hypot(ch.gyro_bias, ch.gyro_drift[0]))
             except (ValueError, np.linalg.LinAlgError):
                 continue
             own = d.get("drift")
             d.update(_clean(res.to_dict()))
             d["drift_own_circle"] = own
-            d["drift_method"] = "day's drift line through all circles (both sides)"
+            d["drift_method"] = ("current from the water-track log plus the circles' mean loop leeway"
+                                 if isinstance(day, LeewayDrift) else "day's drift line through all circles (both sides)")
     for r in runs:
         kind = r["maneuver"].get("type")
         p = r["maneuver"]
@@ -512,7 +588,9 @@ def reduce_maneuvering(rec: Record) -> dict:
                 res = RE.reach_analysis(w["t"], w["north"], w["east"], r["t_execute"], heading=w["heading"],
                                         t_heading=w["t_heading"], drift=drift, approach_s=approach,
                                         seed=int(r["run"]), fix_errors=ch.fix_errors,
-                                        timing_sd=ch.timing_sd(r["t_execute"]), velocity=ch.velocity)
+                                        timing_sd=ch.timing_sd(r["t_execute"]), velocity=ch.velocity,
+                                        water=None if ch.water is None else
+                                        (ch.t_water, ch.water[:, 0], ch.water[:, 1], *ch.water_accuracy))
                 d.update(_clean(res.to_dict()))
                 cv = res.curve
                 if cv:

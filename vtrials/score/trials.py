@@ -266,8 +266,13 @@ def drift_corrected_turns(truth: dict) -> dict:
     over the trial's turns of each one's water-track drift from 360° to 720° (the part that flips with
     the side of the turn averages out, as in the reduction). Advance, transfer and tactical diameter
     are corrected to first order (position less drift × time from EXECUTE); the water-track values are
-    kept as ``*_water_track_m``. Turns shorter than 720° give no drift; with none, nothing changes."""
-    loops = [r["loop_drift_mps"] for r in truth.values() if r.get("loop_drift_mps")]
+    kept as ``*_water_track_m``. A turn that ends a little short of 720° (its FINEX called on the
+    crew's gyro) gives the drift of its last 360° (``steady_loop_drift_mps``, the loop its steady
+    values come from), as the reduction takes it (:func:`vtrials.reduce.turning.drift_over_loop`):
+    leaving such a turn out made the reference the other side's leeway alone on KVLCC2's day of one
+    35° circle per side. Turns without a steady loop give no drift; with none, nothing changes."""
+    loops = [r.get("loop_drift_mps") or r["steady_loop_drift_mps"] for r in truth.values()
+             if r.get("loop_drift_mps") or r.get("steady_loop_drift_mps")]
     if not loops:
         return truth
     dn, de = np.mean(loops, axis=0)
