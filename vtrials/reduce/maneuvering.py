@@ -94,6 +94,8 @@ class Channels:
         self.gyro_resolution = float(gm.get("resolution_rad", 0.0))
         heading_raw = None
         lat = (rec.team.get("site") or {}).get("latitude_deg")
+        # each logger clock's stated synchronisation offset and drift (record meta: the data sheet)
+        self.gyro_clock = ZZ.Clock.from_meta(gm)
         if self.heading is not None:
             self.heading = np.unwrap(self.heading)
             heading_raw = self.heading
@@ -153,6 +155,9 @@ class Channels:
         # the synchros' calibration uncertainty, common to every reading (of the mean of n synchros)
         cal = [float(rec.meta(r).get("calibration_uncertainty_rad", 0.0)) for r in rud]
         self.rudder_cal = math.sqrt(sum(c * c for c in cal)) / max(len(cal), 1)
+        # the rudder signal is the mean of the synchros, each on its own clock: its time error is the
+        # mean of theirs
+        self.rudder_clock = ZZ.Clock.mean([ZZ.Clock.from_meta(rec.meta(r)) for r in rud]) if rud else ZZ.Clock()
         if rud:
             self.t_rudder, r0 = rec.channel(rud[0], "angle")
             vals = [r0] + [np.interp(self.t_rudder, *rec.channel(r, "angle")) for r in rud[1:]]
@@ -604,7 +609,8 @@ def reduce_maneuvering(rec: Record) -> dict:
             elif kind == "zigzag":
                 res = ZZ.zigzag_metrics(w["t_heading"], w["heading"], w["t_rudder"], w["rudder"],
                                         check_angle=p["check"], approach_s=approach,
-                                        heading_resolution=ch.gyro_resolution)
+                                        heading_resolution=ch.gyro_resolution,
+                                        clock_heading=ch.gyro_clock, clock_rudder=ch.rudder_clock)
                 d.update(_clean(res.to_dict()))
                 _add_gyro_drift(d, 0.5 * approach, ch.gyro_drift)
                 d["rudder_ordered"] = p["rudder"]

@@ -32,6 +32,16 @@ starboard, ψ₀ = base course = circular mean heading over the ``approach_s`` b
   (from the counter-rudder execute to the first heading extreme, where the yaw is checked);
   period = t_exec,4 − t_exec,2 (one full cycle between like executes); ``period_heading`` = c₃ − c₁.
 * ``helm_delay`` = mean(t_exec,k+1 − c_k): how late the rudder was reversed after the threshold.
+
+Clocks (:class:`Clock`): the gyro and the rudder synchros are logged on their own clocks, each
+synchronised to the trial's time base with a stated offset SD and a drift (ppm SD) since the
+synchronisation at ``t_ref`` (record meta, the loggers' data sheet). A time measured between a
+heading feature and a rudder execute (initial turning time, time to check yaw, overshoot times)
+carries both clocks' errors at those instants, var = σ_g(t_a)² + σ_r(t_b)² with
+σ(t)² = σ_off² + (ppm·10⁻⁶·(t − t_ref))²; one hour into a trial 10 ppm alone is 0.036 s, which
+for a fast patrol vessel is several times the gyro-noise SE of a crossing. Differences on one
+clock (the period between like executes, between heading crossings) keep only the drift over the
+interval.
 """
 
 from __future__ import annotations
@@ -234,6 +244,46 @@ def _peak(th, f, t0, t1, sig, drop):
     return float(tc + xp * hw), float(fp), var_x * hw ** 2, var_f
 
 
+# ------------------------------------------------------------------------------------------- clocks
+@dataclasses.dataclass(frozen=True)
+class Clock:
+    """A logger clock's stated timing accuracy: offset SD [s] at synchronisation, drift SD [ppm],
+    synchronisation instant t_ref [s] (record meta ``clock_offset_sd_s``, ``clock_drift_ppm_sd``,
+    ``clock_t_ref_s``)."""
+
+    offset_sd: float = 0.0
+    drift_ppm_sd: float = 0.0
+    t_ref: float = 0.0
+
+    @classmethod
+    def from_meta(cls, meta: dict) -> "Clock":
+        return cls(float(meta.get("clock_offset_sd_s", 0.0)), float(meta.get("clock_drift_ppm_sd", 0.0)),
+                   float(meta.get("clock_t_ref_s", 0.0)))
+
+    @classmethod
+    def mean(cls, clocks: list) -> "Clock":
+        """The clock of a signal averaged over n independent loggers (its time error is the mean of
+        theirs): offset and drift SDs add in quadrature over n."""
+        if not clocks:
+            return cls()
+        n = len(clocks)
+        return cls(math.sqrt(sum(c.offset_sd ** 2 for c in clocks)) / n,
+                   math.sqrt(sum(c.drift_ppm_sd ** 2 for c in clocks)) / n, clocks[0].t_ref)
+
+    def sd(self, t: float) -> float:
+        """SD [s] of the clock's time error at time t."""
+        return math.hypot(self.offset_sd, self.drift_ppm_sd * 1e-6 * (t - self.t_ref))
+
+    def interval_sd(self, t0: float, t1: float) -> float:
+        """SD [s] of an interval t1 − t0 measured on this one clock (its drift over the interval)."""
+        return self.drift_ppm_sd * 1e-6 * abs(t1 - t0)
+
+
+def _between(a: Estimate, ta: float, ca: Clock, b: Estimate, tb: float, cb: Clock) -> Estimate:
+    """a − b for instants logged on two independent clocks (see the module docstring)."""
+    return Estimate(a.value - b.value, math.sqrt(a.std ** 2 + b.std ** 2 + ca.sd(ta) ** 2 + cb.sd(tb) ** 2))
+
+
 # ------------------------------------------------------------------------------------------ result
 @dataclasses.dataclass
 class ZigZagResult:
@@ -274,13 +324,17 @@ class ZigZagResult:
 
 def zigzag_metrics(t_heading, heading, t_rudder, rudder, *, check_angle: float | None = None,
                    approach_s: float = 60.0, peak_drop: float = 2.0 * DEG, heading_resolution: float = 0.0,
-                   sigma_heading: float | None = None) -> ZigZagResult:
+                   sigma_heading: float | None = None, clock_heading: Clock | None = None,
+                   clock_rudder: Clock | None = None) -> ZigZagResult:
     """Reduce a zig-zag run (see the module docstring).
 
     ``check_angle`` α [rad]; default: the rudder amplitude rounded to the nearest degree (the 10°/10°
     and 20°/20° tests). ``approach_s`` [s] base-course window; ``peak_drop`` [rad] peak-fit window;
-    ``heading_resolution`` [rad] gyro step added as resolution/√12 to the noise.
+    ``heading_resolution`` [rad] gyro step added as resolution/√12 to the noise;
+    ``clock_heading``, ``clock_rudder``: the two records' clocks (default: perfect clocks).
     """
+    cg = clock_heading or Clock()
+    cr = clock_rudder or Clock()
     notes: list[str] = []
     th, psi = _clean(t_heading, heading)
     psi = np.unwrap(psi)
@@ -334,23 +388,27 @@ def zigzag_metrics(t_heading, heading, t_rudder, rudder, *, check_angle: float |
             break
         tp, fp, vt, vf = pk
         res.overshoots.append(Estimate(fp - alpha, math.sqrt(vf + psi0_se ** 2)))
-        res.overshoot_times.append(Estimate(tp - t_exec1.value, math.hypot(math.sqrt(vt), t_exec1.std)))
+        res.overshoot_times.append(_between(Estimate(tp, math.sqrt(vt)), tp, cg, t_exec1, t_exec1.value, cr))
         if j == 0:
             res.first_overshoot = res.overshoots[-1]
             res.first_overshoot_time = res.overshoot_times[-1]
             if len(moves) >= 2:
-                res.time_to_check_yaw = Estimate(tp - moves[1].t.value, math.hypot(math.sqrt(vt), moves[1].t.std))
+                res.time_to_check_yaw = _between(Estimate(tp, math.sqrt(vt)), tp, cg, moves[1].t,
+                                                 moves[1].t.value, cr)
         elif j == 1:
             res.second_overshoot = res.overshoots[-1]
             res.second_overshoot_time = res.overshoot_times[-1]
     if crossings:
-        res.initial_turning_time = _diff(crossings[0][0], t_exec1)
+        res.initial_turning_time = _between(crossings[0][0], crossings[0][0].value, cg, t_exec1, t_exec1.value, cr)
     else:
         notes.append("heading never reached the check angle")
     if len(moves) >= 4:
-        res.period = _diff(moves[3].t, moves[1].t)
+        p = _diff(moves[3].t, moves[1].t)
+        res.period = Estimate(p.value, math.hypot(p.std, cr.interval_sd(moves[1].t.value, moves[3].t.value)))
     if len(crossings) >= 3:
-        res.period_heading = _diff(crossings[2][0], crossings[0][0])
+        p = _diff(crossings[2][0], crossings[0][0])
+        res.period_heading = Estimate(p.value, math.hypot(p.std, cg.interval_sd(crossings[0][0].value,
+                                                                                 crossings[2][0].value)))
     delays = [moves[k + 1].t.value - crossings[k][0].value for k in range(min(len(moves) - 1, len(crossings)))]
     if delays:
         res.helm_delay = float(np.mean(delays))

@@ -376,7 +376,7 @@ def _mv_markdown(tr: dict, figs: list[str]) -> list[str]:
             "head_reach": ("m", 1), "lateral_deviation": ("m", 1), "terminal_speed": ("kn", 1 / KNOT),
             "time_to_terminal_speed": ("s", 1), "time_to_90_percent": ("s", 1), "first_overshoot": ("°", 180 / math.pi),
             "second_overshoot": ("°", 180 / math.pi), "initial_turning_time": ("s", 1), "time_to_check_yaw": ("s", 1),
-            "period": ("s", 1)}
+            "period": ("s", 1), "period_heading": ("s", 1)}
     for r in err["runs"]:
         for k, c in r.items():
             if not isinstance(c, dict) or "truth" not in c or k not in unit or c.get("reduced") is None:
