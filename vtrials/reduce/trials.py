@@ -546,7 +546,7 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     groups' fit; the log's departures from a straight line, e.g. cross-flow at low speed, for the
     calibration fit). Returns a dict: ``names`` of the parameters, ``x``, ``cov`` (from the weights,
     absolute), ``A`` (the linearised estimator, parameters per leg speed over ground), ``dof``,
-    ``t_ref``, ``residuals`` [m/s], ``tau``, ``groups`` (those with a U), ``gi`` and ``chi2``."""
+    ``t_ref``, ``residuals`` [m/s], ``tau``, ``groups`` (those with a U) and ``chi2``."""
     t, heading, vg, vg_std = (np.asarray(a, dtype=float) for a in (t, heading, vg, vg_std))
     has = np.zeros(vg.size, bool) if reading is None else np.isfinite(np.asarray(reading, float))
     rd = np.where(has, 0.0 if reading is None else np.asarray(reading, float), 0.0)
@@ -588,8 +588,7 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     names = ["intercept", "slope"][:ncal] + [f"U[{g}]" for g in groups] + \
         [f"{c}_{k}" for k in range(order + 1) for c in ("north", "east")]
     return {"names": names, "x": x * unit, "cov": cov * np.outer(unit, unit), "A": A * unit[:, None],
-            "dof": dof, "t_ref": tm, "residuals": r, "tau": tau, "groups": groups, "gi": gi, "chi2": chi2,
-            "ncal": ncal}
+            "dof": dof, "t_ref": tm, "residuals": r, "tau": tau, "groups": groups, "chi2": chi2}
 
 
 def _leg_drift(runs: list[dict], kinds: dict) -> tuple[np.ndarray, str]:
