@@ -118,22 +118,30 @@ def noise_sigma(t, y, chunk: int = 12) -> tuple[float, int]:
     if n < 6:
         return float("nan"), 0
     m = max(6, min(chunk, n))
-    var, dof = [], []
+    bounds = []  # consecutive chunks of m samples; a tail shorter than 6 folds into the last one
     for i0 in range(0, n - 5, m):
-        i1 = min(n, i0 + m)
-        if n - i1 < 6:  # fold a short tail into the last chunk
-            i1 = n
-        tt = t[i0:i1]
-        if len(tt) < 6:
+        i1 = n if n - min(n, i0 + m) < 6 else i0 + m
+        bounds.append((i0, i1))
+        if i1 == n:
             break
+    full = [b for b in bounds if b[1] - b[0] == m]
+    var, dof = [], []
+    if full:  # the equal chunks at once: residuals off the cubic's column space (batched QR)
+        i0s = np.array([b[0] for b in full])[:, None] + np.arange(m)
+        tt, yy = t[i0s], y[i0s]
+        x = (tt - tt.mean(axis=1, keepdims=True)) / np.maximum(np.ptp(tt, axis=1), 1e-9)[:, None]
+        q, _ = np.linalg.qr(x[..., None] ** np.arange(3, -1, -1))
+        r = yy - np.einsum("bij,bj->bi", q, np.einsum("bij,bi->bj", q, yy))
+        var.extend(np.einsum("bi,bi->b", r, r) / (m - 4))
+        dof.extend([m - 4] * len(full))
+    for i0, i1 in (b for b in bounds if b[1] - b[0] != m):
+        tt = t[i0:i1]
         x = (tt - tt.mean()) / max(np.ptp(tt), 1e-9)
         A = np.vander(x, 4)
         coef, *_ = np.linalg.lstsq(A, y[i0:i1], rcond=None)
         r = y[i0:i1] - A @ coef
         var.append(float(r @ r) / (len(tt) - 4))
         dof.append(len(tt) - 4)
-        if i1 == n:
-            break
     var, dof = np.array(var), np.array(dof)
     med = np.median(var)
     keep = var <= 10.0 * med if med > 0 else np.ones(var.shape, bool)
