@@ -617,7 +617,8 @@ def reduce_maneuvering(rec: Record) -> dict:
                 res = ZZ.zigzag_metrics(wz["t_heading"], wz["heading"], w["t_rudder"], w["rudder"],
                                         check_angle=p["check"], approach_s=approach,
                                         heading_resolution=ch.gyro_resolution,
-                                        clock_heading=ch.gyro_clock, clock_rudder=ch.rudder_clock)
+                                        clock_heading=ch.gyro_clock, clock_rudder=ch.rudder_clock,
+                                        gyro_drift=ch.gyro_drift)
                 d.update(_clean(res.to_dict()))
                 _add_gyro_drift(d, 0.5 * approach, ch.gyro_drift)
                 d["rudder_ordered"] = p["rudder"]

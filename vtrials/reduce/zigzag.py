@@ -21,7 +21,12 @@ starboard, ψ₀ = base course = circular mean heading over the ``approach_s`` b
   exact; a first-order servo makes it the "effective" start.
 * Heading-threshold crossings c_k (f = +α, −α, +α, … alternately): local quadratic fit of the heading
   around the first sample beyond the level, solved for the crossing; SE = σ(f̂)/|ḟ| with σ from the
-  gyro noise (residuals of piecewise cubic fits) and the base-course SE.
+  gyro noise (residuals of piecewise cubic fits), the base-course SE and the gyro's slow wander
+  (Gauss–Markov σ, τ of the maker's specification) since the middle of the approach,
+  var = 2σ²(1 − e^(−Δt/τ)), all divided by the rate of turn at the crossing: on a slow ship the
+  wander dominates (KVLCC2, 0.3°/s: 0.08° over 100 s is 0.1 s), on a quick one the noise does. The
+  period between like crossings keeps the noise of both and the wander between them (the base
+  course cancels).
 * Overshoot k: the extreme of f (alternately max and min) between consecutive crossings, refined by
   a least-squares cubic over the samples within which f stays within ``peak_drop`` of the extreme
   (≥ 7 samples), extreme from the cubic's stationary point. The window is kept short (0.5° below
@@ -330,14 +335,22 @@ class ZigZagResult:
 def zigzag_metrics(t_heading, heading, t_rudder, rudder, *, check_angle: float | None = None,
                    approach_s: float = 60.0, peak_drop: float = 0.5 * DEG, heading_resolution: float = 0.0,
                    sigma_heading: float | None = None, clock_heading: Clock | None = None,
-                   clock_rudder: Clock | None = None) -> ZigZagResult:
+                   clock_rudder: Clock | None = None, gyro_drift: tuple[float, float] = (0.0, 1.0)) -> ZigZagResult:
     """Reduce a zig-zag run (see the module docstring).
 
     ``check_angle`` α [rad]; default: the rudder amplitude rounded to the nearest degree (the 10°/10°
     and 20°/20° tests). ``approach_s`` [s] base-course window; ``peak_drop`` [rad] peak-fit window;
     ``heading_resolution`` [rad] gyro step added as resolution/√12 to the noise;
-    ``clock_heading``, ``clock_rudder``: the two records' clocks (default: perfect clocks).
+    ``clock_heading``, ``clock_rudder``: the two records' clocks (default: perfect clocks);
+    ``gyro_drift`` (σ [rad], τ [s]): the gyro's slow wander (Gauss–Markov, the maker's specification)
+    that moves the heading crossings (see the module docstring).
     """
+    gd_sd, gd_tau = float(gyro_drift[0]), max(float(gyro_drift[1]), 1e-9)
+
+    def wander_var(dt: float) -> float:
+        # variance of the change of a Gauss–Markov error (σ, τ) over dt: 2σ²(1 − e^(−|dt|/τ))
+        return 2.0 * gd_sd ** 2 * (1.0 - math.exp(-abs(dt) / gd_tau)) if gd_sd > 0 else 0.0
+
     cg = clock_heading or Clock()
     cr = clock_rudder or Clock()
     notes: list[str] = []
@@ -374,13 +387,15 @@ def zigzag_metrics(t_heading, heading, t_rudder, rudder, *, check_angle: float |
         if c is None:
             break
         tc, se, sl = c
-        se = math.hypot(se, psi0_se / max(abs(sl), 1e-12))
-        crossings.append((Estimate(tc, se), sgn))
+        asl = max(abs(sl), 1e-12)
+        # against the base course: its SE and the gyro's wander since the middle of the approach
+        se_base = math.sqrt(se ** 2 + (psi0_se / asl) ** 2 + wander_var(tc - (t1 - 0.5 * approach_s)) / asl ** 2)
+        crossings.append((Estimate(tc, se_base), sgn, se, asl))
         after = tc
         sgn = -sgn
-    res.crossings = [c for c, _ in crossings]
+    res.crossings = [c[0] for c in crossings]
     t_exec1 = moves[0].t
-    for j, (c, sg_) in enumerate(crossings):
+    for j, (c, sg_, _, _) in enumerate(crossings):
         t_next = crossings[j + 1][0].value if j + 1 < len(crossings) else th[-1]
         if j + 1 >= len(crossings):
             # the extreme after the last crossing counts only if the heading has turned back by then
@@ -411,9 +426,12 @@ def zigzag_metrics(t_heading, heading, t_rudder, rudder, *, check_angle: float |
         p = _diff(moves[3].t, moves[1].t)
         res.period = Estimate(p.value, math.hypot(p.std, cr.interval_sd(moves[1].t.value, moves[3].t.value)))
     if len(crossings) >= 3:
-        p = _diff(crossings[2][0], crossings[0][0])
-        res.period_heading = Estimate(p.value, math.hypot(p.std, cg.interval_sd(crossings[0][0].value,
-                                                                                 crossings[2][0].value)))
+        # the base course cancels in the difference; the gyro's wander between the two crossings
+        # (same side, same slope sign) and the logger clock's drift over the interval remain
+        (c1, _, s1, a1), (c3, _, s3, a3) = crossings[0], crossings[2]
+        dt = c3.value - c1.value
+        res.period_heading = Estimate(dt, math.sqrt(s1 ** 2 + s3 ** 2 + wander_var(dt) / (0.5 * (a1 + a3)) ** 2
+                                                    + cg.interval_sd(c1.value, c3.value) ** 2))
     delays = [moves[k + 1].t.value - crossings[k][0].value for k in range(min(len(moves) - 1, len(crossings)))]
     if delays:
         res.helm_delay = float(np.mean(delays))
