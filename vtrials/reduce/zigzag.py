@@ -213,8 +213,14 @@ def _crossing(th, f, level, after, sig):
     return float(tc), float(se), float(sl)
 
 
-def _peak(th, f, t0, t1, sig, drop):
-    """Maximum of f on [t0, t1] refined by a least-squares cubic; (t_peak, f_peak, var_t, var_f)."""
+def _peak(th, f, t0, t1, sig, drop, wander=(0.0, 1.0)):
+    """Maximum of f on [t0, t1] refined by a least-squares cubic; (t_peak, f_peak, var_t, var_f).
+
+    ``wander`` (σ [rad], τ [s]): a Gauss–Markov error of the heading, correlated across the window;
+    its share of the peak time's variance (g·M C Mᵀ·g with M the fit's hat rows, g the gradient of
+    the stationary point, C_ij = σ² e^(−|t_i − t_j|/τ)) is added to var_t: a slope of the error
+    across a flat peak moves it by slope/|f''| (KVLCC2: 0.0017°/s² at the peak, a wander of 0.08°
+    over 900 s tilts a ±24-s window by ~0.001°/s, i.e. ~0.5 s)."""
     m = (th >= t0) & (th <= t1)
     if np.count_nonzero(m) < 3:
         return None
@@ -251,6 +257,10 @@ def _peak(th, f, t0, t1, sig, drop):
     fpp = 2 * c[2] + 6 * c[3] * xp
     gx = -np.array([0.0, 1.0, 2 * xp, 3 * xp ** 2]) / fpp
     var_x = sig ** 2 * float(gx @ G @ gx)
+    if wander[0] > 0:
+        row = gx @ G @ A.T
+        C = wander[0] ** 2 * np.exp(-np.abs(tt[:, None] - tt[None, :]) / max(wander[1], 1e-9))
+        var_x += float(row @ C @ row)
     return float(tc + xp * hw), float(fp), var_x * hw ** 2, var_f
 
 
@@ -403,7 +413,7 @@ def zigzag_metrics(t_heading, heading, t_rudder, rudder, *, check_angle: float |
             g = sg_ * f[tail]
             if g.size < 5 or g[-1] > g.max() - max(peak_drop, 5 * sig):
                 break
-        pk = _peak(th, sg_ * f, c.value, t_next, sig, max(peak_drop, 10.0 * sig))
+        pk = _peak(th, sg_ * f, c.value, t_next, sig, max(peak_drop, 10.0 * sig), (gd_sd, gd_tau))
         if pk is None:
             break
         tp, fp, vt, vf = pk
