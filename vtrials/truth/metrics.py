@@ -171,10 +171,10 @@ def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int
     """Zig-zag (δ/ψ) metrics from EXECUTE (index 0): first and second overshoot angles and times,
     initial turning time (EXECUTE to the first heading threshold), time to check yaw, and the period
     (first to third threshold crossing). Heading changes are counted from ``base`` [rad] (the initial
-    course; default the heading at EXECUTE). Time to check yaw (ITTC 7.5-04-02-01: from the second
-    execute, the counter-rudder, to the first heading extreme, where the yaw is checked): from
-    ``t_counter`` [s] (the instant the rudder started to move to the other side) when given, else
-    from the first threshold crossing (an ideal helm that reverses the rudder at the threshold)."""
+    course; default the heading at EXECUTE). Time to check yaw (from the second execute, the
+    counter-rudder, to the first heading extreme, where the yaw is checked): from ``t_counter`` [s]
+    (the instant the rudder started to move to the other side) when given, else from the first
+    threshold crossing (an ideal helm that reverses the rudder at the threshold)."""
     t = np.asarray(t, float)
     s = 1.0 if first_side > 0 else -1.0
     a = math.radians(heading_deg)
