@@ -168,3 +168,31 @@ def test_truth_counts_from_the_approach_mean_and_the_counter_rudder():
     delay = S["execs"][1] - ref["initial_turning_time_s"]
     assert 0.4 <= delay < 0.42
     assert ref["time_to_check_yaw_s"] - out["time_to_check_yaw_s"] == pytest.approx(delay, abs=0.006)
+
+
+def test_speed_error_of_the_compass_own_velocity():
+    """The compass 120 m aft of the reference point (KVLCC2's) sees the yaw rate's lever arm in its
+    north velocity, ΔV_N = −r (x sin ψ + y cos ψ). Slow ship on 270° (V_N changes fastest with
+    heading), 7.8 m/s: corrected with the reference point's V_N the initial turning time is off by
+    ~0.3 s against its ~0.03 s noise SE; with the compass's own V_N (the reduction's zig-zag
+    heading), within 0.05 s."""
+    S = simulate(K=0.03, T=30.0, delta=20.0, alpha=20.0, gear=2.3, dt=0.02, t_after=30.0, n_exec=3, psi0=270.0)
+    tr = truth(S)
+    V, lat, x = 7.8, math.radians(38.0), -120.0
+    th, h, trd, d = _records(S)
+    sp_t = S["t"]
+    rate = np.interp(th, sp_t, np.gradient(S["psi"], sp_t)) * DEG
+    vn_ref = V * np.cos(h)
+    vn_gyro = vn_ref - rate * x * np.sin(h)
+    gyro = h + GY.speed_error(vn_gyro, lat)
+    tf = np.arange(th[0], th[-1], 1.0)
+    north = np.interp(tf, th, np.concatenate([[0.0], np.cumsum(0.5 * (vn_ref[1:] + vn_ref[:-1]) * np.diff(th))]))
+    r_f = np.interp(tf, th, rate)
+    ps_f = np.interp(tf, th, h)
+    ref = GY.correct_heading(th, gyro, tf, north, lat, v_north=(tf, np.interp(tf, th, vn_ref)))
+    own = GY.correct_heading(th, gyro, tf, north, lat,
+                             v_north=(tf, np.interp(tf, th, vn_ref) - r_f * x * np.sin(ps_f)))
+    e_ref = Z.zigzag_metrics(th, ref, trd, d, sigma_heading=0.03 * DEG).initial_turning_time.value - tr["cross"][0]
+    e_own = Z.zigzag_metrics(th, own, trd, d, sigma_heading=0.03 * DEG).initial_turning_time.value - tr["cross"][0]
+    assert abs(e_ref) > 0.2, e_ref
+    assert abs(e_own) < 0.05, e_own
