@@ -237,10 +237,32 @@ def maneuver_truth(run: Run, att, cols: dict) -> dict:
             out["residual_rate_dps"] = float(np.degrees(np.mean(c["r"][m])))
             out["t_release"] = tr
     elif kind == "zigzag":
-        off = getattr(att, "base_offset", 0.0)  # ordered course − heading at EXECUTE
+        # the base course: the true mean heading over the approach (COMEX to EXECUTE), the course the
+        # ship was steady on when the rudder was put over (seed 002: EXECUTE after 1 min of steady
+        # approach data, then "when the ship's heading has changed 10 deg from the base course");
+        # the ordered course is the autopilot's set point, which the approach's mean heading misses
+        # by the autopilot's slow wander (0.04° SD on the patrol vessel's 60-s approaches), not a
+        # property of the ship. Time to check yaw: from the counter-rudder execute, the instant the
+        # true rudder started to move to the other side (the helm reacts a step or more after the
+        # threshold), the reduction's definition
+        psi = np.unwrap(cols["heading"])
+        ma = (t >= getattr(att, "t_comex", att.t_execute - 60.0) - 1e-9) & (t <= att.t_execute + 1e-9)
+        k0 = int(np.flatnonzero(w)[0])
+        base = float(np.mean(psi[ma])) - float(psi[k0]) + float(c["heading"][0]) if np.any(ma) else None
+        side = 1 if p["rudder"] > 0 else -1
+        rudders = [k for k in c if re.fullmatch(r"rudder_\d+", k)]
+        rud = np.mean([c[k] for k in rudders], axis=0) if rudders else None
+        first = TM.zigzag(c["t"], c["heading"], rudder_deg=abs(math.degrees(p["rudder"])),
+                          heading_deg=math.degrees(p["check"]), first_side=side, base=base)
+        # the counter-rudder execute: the true rudder's move to the other side after the threshold
+        t_counter = None
+        if "initial_turning_time_s" in first and rud is not None:
+            t_counter = TM.rudder_move_start(c["t"], rud, c["t"][0] + first["initial_turning_time_s"],
+                                             -side * abs(p["rudder"]))
         out.update(TM.zigzag(c["t"], c["heading"], rudder_deg=abs(math.degrees(p["rudder"])),
-                             heading_deg=math.degrees(p["check"]), first_side=1 if p["rudder"] > 0 else -1,
-                             base=float(c["heading"][0]) + off))
+                             heading_deg=math.degrees(p["check"]), first_side=side, base=base,
+                             t_counter=t_counter))
+        out["t_counter_execute"] = t_counter
         out["approach_speed_mps"] = float(math.hypot(c["u_r"][0], c["v_r"][0]))
     elif kind == "speed_change":
         out.update(TM.speed_change(c["t"], c["x_w"], c["y_w"], c["heading"], c["u_r"], c["v_r"]))

@@ -136,12 +136,45 @@ def _peak(t: np.ndarray, f: np.ndarray, i0: int, i1: int) -> tuple[float, float]
     return float(f[k]), float(t[k])
 
 
+def rudder_move_start(t, rudder, t_after: float, level_to: float) -> float | None:
+    """Start [s] of the first rudder move after ``t_after`` toward ``level_to`` [rad] (the
+    counter-rudder execute of a zig-zag): the straight line through the true angles between 10 % and
+    90 % of the swing from the level held at ``t_after``, intersected with that level (the instant
+    the rudder leaves it, exact for a steering gear moving at its rate limit). None if the rudder
+    does not pass half the swing."""
+    t = np.asarray(t, float)
+    d = np.asarray(rudder, float)
+    k0 = min(int(np.searchsorted(t, t_after)), len(t) - 1)
+    L0 = float(d[k0])
+    sw = float(level_to) - L0
+    if sw == 0.0:
+        return None
+    frac = (d[k0:] - L0) / sw
+    beyond = np.flatnonzero(frac >= 0.5)
+    if beyond.size == 0:
+        return None
+    a = b = k0 + int(beyond[0])
+    while a - 1 > k0 and (d[a - 1] - L0) / sw > 0.1:
+        a -= 1
+    while b + 1 < len(d) and (d[b + 1] - L0) / sw < 0.9:
+        b += 1
+    if b == a:
+        a = max(a - 1, k0)
+    if b <= a:
+        return None
+    slope, icpt = np.polyfit(t[a:b + 1], d[a:b + 1], 1)
+    return float((L0 - icpt) / slope) if slope != 0.0 else None
+
+
 def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int,
-           base: float | None = None) -> dict:
+           base: float | None = None, t_counter: float | None = None) -> dict:
     """Zig-zag (δ/ψ) metrics from EXECUTE (index 0): first and second overshoot angles and times,
-    initial turning time (EXECUTE to the first heading threshold, i.e. the second execute), time
-    to check yaw, and the period (first to third threshold crossing). Heading changes are counted
-    from ``base`` [rad] (the ordered course; default the heading at EXECUTE)."""
+    initial turning time (EXECUTE to the first heading threshold), time to check yaw, and the period
+    (first to third threshold crossing). Heading changes are counted from ``base`` [rad] (the initial
+    course; default the heading at EXECUTE). Time to check yaw (from the second execute, the
+    counter-rudder, to the first heading extreme, where the yaw is checked): from ``t_counter`` [s]
+    (the instant the rudder started to move to the other side) when given, else from the first
+    threshold crossing (an ideal helm that reverses the rudder at the threshold)."""
     t = np.asarray(t, float)
     s = 1.0 if first_side > 0 else -1.0
     a = math.radians(heading_deg)
@@ -155,7 +188,7 @@ def zigzag(t, heading, *, rudder_deg: float, heading_deg: float, first_side: int
     end1 = c2[1] if c2 is not None else len(t)
     pk1, tp1 = _peak(t, f, c1[1], end1)
     out["first_overshoot_deg"] = math.degrees(pk1 - a)
-    out["time_to_check_yaw_s"] = tp1 - c1[0]
+    out["time_to_check_yaw_s"] = tp1 - (c1[0] if t_counter is None else t_counter)
     out["first_overshoot_time_s"] = tp1 - t[0]
     if c2 is None:
         return out
