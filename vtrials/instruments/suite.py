@@ -48,6 +48,8 @@ KINDS = {**SHIP_KINDS, **WAVE_KINDS}  # ship instruments, then the sea's (wave b
 CATALOGUE = Path(__file__).resolve().parent / "catalogue.toml"
 SEED_KEY = 4  # spawn-key namespace of instrument streams
 CLOCK_KEY = 5  # spawn-key namespace of the instruments' logger clocks
+WINDAGE_KEY = 6  # spawn-key namespace of the team's wind-tunnel coefficients
+WINDAGE_REL_STD = 0.05  # the team's wind coefficients' scale error, 1σ: what its reduction states
 DEFAULT_CLOCK = "logger_clock"
 
 
@@ -190,6 +192,8 @@ class InstrumentSet:
                 merged[e.name] = (Entry(**fields), {**bsets, **sets}, scenario_file, where)
             else:
                 merged[e.name] = (e, sets, scenario_file, where)
+        self.seed = seed
+        self.stream = tuple(stream)
         self.team = self._team(site_info)
         self.devices = {}
         self.clocks: dict[str, ClockOffset | None] = {}
@@ -205,8 +209,6 @@ class InstrumentSet:
             aw = load_airwake(vessel.folder, vessel.sites)
             for d in sonic:
                 d.set_airwake(aw, vessel.sites)
-        self.seed = seed
-        self.stream = tuple(stream)
         self._out: dict[str, list] = {}
 
     def _team(self, site_info: dict) -> dict:
@@ -222,9 +224,16 @@ class InstrumentSet:
             ang = np.radians(np.arange(0.0, 181.0, 10.0))
             cx, cy, cn, ck = wind_coefficients(ang, v.windage)
             w = v.windage
+            # the team's coefficients are a wind-tunnel test of a model of the ship, not the ship's own:
+            # one scale error per trial, drawn with the 5 % (1σ) the reduction states for them
+            # (vtrials.reduce.trials, cx_rel_std) — else the wind correction would share the truth's model
+            rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(WINDAGE_KEY, *self.stream)))
+            k = 1.0 + WINDAGE_REL_STD * float(rng.standard_normal())
             team["windage"] = {"A_F_m2": w.A_F, "A_L_m2": w.A_L, "L_oa_m": w.L_oa,
-                               "angles_rad": ang.tolist(), "C_X": np.asarray(cx).tolist(),
-                               "C_Y": np.asarray(cy).tolist(), "C_N": np.asarray(cn).tolist()}
+                               "source": "wind-tunnel test of a model: the ship's coefficients with one scale "
+                                         f"error, drawn N(0, {WINDAGE_REL_STD:.0%}) per trial",
+                               "C_rel_std": WINDAGE_REL_STD, "angles_rad": ang.tolist(), "C_X": (k * np.asarray(cx)).tolist(),
+                               "C_Y": (k * np.asarray(cy)).tolist(), "C_N": (k * np.asarray(cn)).tolist()}
         return team
 
     @staticmethod

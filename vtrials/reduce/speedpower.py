@@ -302,7 +302,9 @@ def relative_wind(v_wt, psi_wt, v_g):
 @dataclasses.dataclass(frozen=True)
 class WindResistance:
     """R_AA [N] per run with std; the wind used: v_wr_ref, psi_wr_ref (relative, at the reference
-    height), v_wt, psi_wt (true, at the anemometer height, relative to the bow)."""
+    height), v_wt, psi_wt (true, at the anemometer height, relative to the bow). coef_sens [N]: the
+    signed change of each run's R_AA for a +1σ error of the coefficient (part of ``std``), one error
+    common to the runs, so that a mean over runs can combine it with its signs."""
 
     r_aa: np.ndarray
     std: np.ndarray
@@ -310,6 +312,7 @@ class WindResistance:
     psi_wr_ref: np.ndarray
     v_wt: np.ndarray
     psi_wt: np.ndarray
+    coef_sens: np.ndarray | None = None
 
 
 def average_true_wind(v_wt, psi_wt, heading):
@@ -396,11 +399,13 @@ def wind_resistance(v_wr, psi_wr, v_g, cx: Callable, a_xv, rho_a=RHO_AIR, z_anem
         h = 1e-6
         d = (_r_aa(v_wr, psi_wr + h, v_g, *args)[0] - _r_aa(v_wr, psi_wr - h, v_g, *args)[0]) / (2 * h)
         var = var + (d * np.asarray(psi_wr_std, dtype=float)) ** 2
+    sens = np.zeros_like(r)
     if cx_rel_std:
         first = 0.5 * rho_a * a_xv * np.asarray(cx(pr_ref), dtype=float) * vr_ref ** 2
-        var = var + (cx_rel_std * first) ** 2
+        sens = cx_rel_std * first
+        var = var + sens ** 2
     return WindResistance(r_aa=r, std=np.sqrt(var), v_wr_ref=vr_ref, psi_wr_ref=pr_ref, v_wt=vwt,
-                          psi_wt=pwt)
+                          psi_wt=pwt, coef_sens=sens)
 
 
 def direct_power_method(p_ms, delta_r, v_s, eta_d_id, eta_d_ms=None, p_ms_std=None,

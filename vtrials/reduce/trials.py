@@ -364,6 +364,7 @@ def reduce_standardization(rec: Record) -> dict:
         except (ValueError, np.linalg.LinAlgError, RuntimeError):
             continue
     slope = _tank_log_slope(tank)
+    kinds = _by_kind(rec)
     spots = []
     for g in groups:
         rs = [r for r in runs if r["group"] == g]
@@ -375,14 +376,17 @@ def reduce_standardization(rec: Record) -> dict:
         # wind: R_AA per run from the measured relative wind, then the direct power method
         d_r = np.zeros(n)
         d_r_se = np.zeros(n)
+        d_r_coef = np.zeros(n)  # the wind coefficient's part of d_r_se: one error, signed per run
+        d_r_wave = np.zeros(n)  # STAWAVE's part: a method error, not seen in the runs' scatter
         wind_used = []
         if windinfo is not None and all("wind" in r for r in rs):
             cx, a_xv = windinfo
+            cx_rel = float(team["windage"].get("C_rel_std", 0.05))  # the wind-tunnel data's stated accuracy
             wr = SP.wind_resistance([r["wind"]["speed"] for r in rs], [r["wind"]["angle"] for r in rs], v, cx,
                                     a_xv, rho_air, z_anemometer=rs[0]["wind"]["height_m"], z_ref=10.0,
-                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=0.05,
+                                    v_wr_std=[r["wind"]["speed_se"] for r in rs], cx_rel_std=cx_rel,
                                     heading=[r["course"] for r in rs] if n > 1 else None)
-            d_r, d_r_se = wr.r_aa, wr.std
+            d_r, d_r_se, d_r_coef = wr.r_aa, wr.std, wr.coef_sens
             wind_used = [{"r_aa": float(a), "v_wt": float(b), "psi_wt": float(c)}
                          for a, b, c in zip(wr.r_aa, wr.v_wt, wr.psi_wt)]
         # waves: STAWAVE-2 on the runs with the observed sea within ±45° of the bow (ITTC 7.5-04-01-01.1)
@@ -396,6 +400,7 @@ def reduce_standardization(rec: Record) -> dict:
                 raw, raw_se = STA.run_wave_resistance(sea, r["course"], vs.value, L_, B_, T_, c_b, rho=rho_w)
                 d_r[i] += raw
                 d_r_se[i] = math.hypot(d_r_se[i], raw_se)
+                d_r_wave[i] = raw_se
                 waves_used.append({"r_aw": raw, "std": raw_se})
         # the runs' residual acceleration (SP.acceleration_resistance): inertia is not calm-water power
         r_acc = np.zeros(n)
@@ -408,8 +413,10 @@ def reduce_standardization(rec: Record) -> dict:
         if eta is not None:
             p_id, p_id_se = SP.direct_power_method(p_ms, d_r, vs.value, float(eta), p_ms_std=p_ms_se,
                                                    delta_r_std=d_r_se, xi_p=xi)
+            p_coef, p_wave = d_r_coef * vs.value / float(eta), d_r_wave * vs.value / float(eta)
         else:
             p_id, p_id_se = p_ms, p_ms_se
+            p_coef, p_wave = np.zeros(n), np.zeros(n)
         w = CUR.mean_of_means_weights(n)
         P_ms = _mom(p_ms, p_ms_se)
         # the torsionmeters' calibration uncertainty is common to the spot's runs: added after averaging
@@ -431,7 +438,9 @@ def reduce_standardization(rec: Record) -> dict:
                       "method": f"joint fit of the day's runs (current change: {joint.model})",
                       "stw": _est(vs), "power_measured": _est(P_ms), "power": None,
                       "power_speed_std": p_speed, "power_calibration_std": cal,
-                      "_corrected": (np.asarray(p_id, float), np.asarray(p_id_se, float), np.sign(s_i), vs.dof),
+                      "_corrected": (np.asarray(p_id, float), np.asarray(p_id_se, float), np.sign(s_i), vs.dof,
+                                     _log_speed_factor(rs, kinds, slope(vs.value)), np.asarray(p_coef, float),
+                                     np.asarray(p_wave, float)),
                       "rps": rps.value, "torque": torque, "thrust": thrust,
                       "current_along_base": current_along, "wind": wind_used, "waves": waves_used,
                       "eta_D": None if eta is None else float(eta), "xi_P": xi,
@@ -475,43 +484,74 @@ def reduce_standardization(rec: Record) -> dict:
     return out
 
 
+def _log_speed_factor(rs: list[dict], kinds: dict, k: float) -> np.ndarray | None:
+    """(L_i / L̄)^k per run: how much of a run's power is its own speed through water, from a speed log's
+    mean reading L_i per run (the Doppler log's fore-aft speed, else the EM log) and the curve's slope
+    k = d ln P / d ln V. At constant shaft speed a run into a gust or a stronger wind goes slower and
+    needs less power; the ratio of one log's readings carries that change without the log's scale
+    error (common to the runs), which cancels. None without a log reading on every run."""
+    for kind, ch in (("doppler_log", "u"), ("em_log", "speed")):
+        for name in kinds.get(kind, []):
+            st = [((r["channels"].get(name) or {}).get(ch) or {}).get("mean") for r in rs]
+            if all(x is not None and math.isfinite(x) and x > 0 for x in st):
+                L = np.asarray(st, float)
+                return (L / L.mean()) ** k
+    return None
+
+
 def _spot_powers(spots: list[dict]) -> None:
     """Each spot's corrected power (mean of means of its runs' direct-power-method powers) and its
     budget, named term by term (GUM, JCGM 100:2008; ITTC 7.5-02-01-01):
 
-    * run-to-run scatter of the corrected power (gusts, helm, sea): the relative scatter of runs on the
-      SAME course at the same spot, pooled over the day's spots (dof = number of such repeats less one
-      per course and spot). Runs on opposite courses differ for a real reason — into the wind the ship is
-      slower and needs less power at the same settings (~q ΔV/V, several per cent at low speed) — which
-      the mean of means balances and which is not scatter. A day without same-course repeats (two-run
-      spots) falls back to the spot's own scatter std/√2 over both courses (conservative);
-    * each run's standard error of its mean power and the uncertainty of its resistance corrections
-      (wind coefficient, relative wind, acceleration: :func:`vtrials.reduce.speedpower.direct_power_method`);
+    * run-to-run scatter of the corrected power AT EQUAL SPEED (gusts, helm, sea): the relative scatter
+      of runs on the SAME course at the same spot, pooled over the day's spots (dof = number of such
+      repeats less one per course and spot), after each run's power is brought to the spot's mean speed
+      through water by the speed log's relative reading (:func:`_log_speed_factor`). A run's power
+      differs from the next for a real reason — at the same shaft speed a run into more wind is slower
+      and needs less power (~k ΔV/V: several per cent on opposite courses, 1–4 % between two runs on
+      the same course an hour apart on KVLCC2 in an NPD-gusted wind) — and the reference, the true
+      curve at the spot's reduced speed, moves with it, because the spot's speed is the same balanced
+      mean of the runs' speeds as its power is of their powers. Counting that change as scatter made
+      the KVLCC2 interval twice as wide as its errors (campaign of 200 trial days: coverage 1.000,
+      sharpness 2.08). Without a log the raw corrected powers are used (conservative). A day without
+      same-course repeats (two-run spots) falls back to the spot's own scatter std/√2 over both courses;
+    * the errors of the resistance corrections that the runs' scatter cannot show: the wind
+      coefficient's (one error common to the runs, signed by each run's wind resistance, so that head
+      and tail wind cancel in the mean only as far as they do) and STAWAVE's. The runs' own noise —
+      of their mean power, relative wind and acceleration, the rest of each run's stated uncertainty
+      (:func:`vtrials.reduce.speedpower.direct_power_method`) — is what the scatter measures, and is
+      not counted twice; a single-run spot takes it as stated;
     * the torsionmeters' zero and scale calibration, common to the spot's runs;
     * the spot speed's uncertainty carried along the curve (``power_speed_std``).
 
     The interval is Student-t on the Welch–Satterthwaite dof of the scatter and speed terms."""
     ss, dof = 0.0, 0
     for sp in spots:
-        p_id, _, sgn, _ = sp["_corrected"]
+        p_id, _, sgn, _, f, _, _ = sp["_corrected"]
+        q = p_id if f is None else p_id / f
         for c in (-1.0, 1.0):
-            x = p_id[sgn == c]
+            x = q[sgn == c]
             if x.size >= 2:
                 rel = x / x.mean() - 1.0
                 ss += float(np.sum(rel ** 2))
                 dof += x.size - 1
     sigma_rel = math.sqrt(ss / dof) if dof > 0 else None
     for sp in spots:
-        p_id, p_id_se, sgn, v_dof = sp.pop("_corrected")
+        p_id, p_id_se, sgn, v_dof, f, p_coef, p_wave = sp.pop("_corrected")
         n = p_id.size
         w = CUR.mean_of_means_weights(n) if n > 1 else np.ones(1)
         if sigma_rel is not None:
             scatter, nu = sigma_rel * p_id, dof
         else:
-            scatter, nu = np.full(n, np.std(p_id, ddof=1) / math.sqrt(2) if n > 1 else 0.0), max(n - 1, 1)
+            q = p_id if f is None else p_id / f
+            scatter, nu = np.full(n, np.std(q, ddof=1) / math.sqrt(2) if n > 1 else 0.0), max(n - 1, 1)
         value = float(np.dot(w, p_id))
+        if n == 1 and sigma_rel is None:  # one run, nothing to pool: its own stated uncertainty
+            scatter = np.sqrt(np.maximum(p_id_se ** 2 - p_coef ** 2 - p_wave ** 2, 0.0))
         u_scatter2 = float(np.sum((w * scatter) ** 2))
-        u_runs2 = float(np.sum((w * p_id_se) ** 2))
+        # on top of the scatter, the errors the runs share: the wind coefficient's (one error, signed
+        # with each run's wind resistance) and STAWAVE's
+        u_runs2 = float(np.dot(w, p_coef)) ** 2 + float(np.sum((w * p_wave) ** 2))
         u_speed = sp["power_speed_std"]
         u2 = u_scatter2 + u_runs2 + sp["power_calibration_std"] ** 2 + u_speed ** 2
         den = u_scatter2 ** 2 / nu + (u_speed ** 4 / v_dof if v_dof else 0.0)
