@@ -113,3 +113,32 @@ def test_steady_rate_is_the_mean_rate_over_the_loop(side):
     m = TM.turning(t, x, y, psi, u, v, r)
     expected = (U / R) * math.sqrt(1 - w * w)
     assert math.radians(m["steady_rate_of_turn_dps"]) == pytest.approx(expected, rel=1e-4)
+
+
+def test_times_are_counted_from_the_execute_instant_between_truth_samples():
+    """The truth is stored every 0.5 s and EXECUTE falls between samples (here 0.3 s before the
+    next). A ramp u = min(U₀ + a(t − t_E), U_T) reaches 90 % of its change at t_E + 0.9(U_T − U₀)/a:
+    counted from the EXECUTE sample that maneuvering.from_execute inserts (the approach carried on to
+    EXECUTE) it is exact; counted from the first stored sample it was 0.9 × 0.3 s short (the later
+    start and its higher initial speed). Angles are carried on along the shorter arc across ±π."""
+    from vtrials.trials.maneuvering import from_execute
+    t = np.arange(0.0, 400.0, 0.5)
+    tE, U0, UT, a = 100.2, 2.0, 8.0, 0.1
+    u = np.clip(U0 + a * (t - tE), U0, UT)
+    x = np.concatenate([[0.0], np.cumsum(0.5 * (u[1:] + u[:-1]) * 0.5)])
+    psi = math.pi - 0.0015 + 0.001 * (t - 99.5)
+    heading = np.remainder(psi + math.pi, 2 * math.pi) - math.pi  # wraps between 99.5 and 100.0
+    cols = {"t": t, "x_w": x, "y_w": 0 * t, "heading": heading, "u_r": u, "v_r": 0 * t}
+    c = from_execute(cols, tE, 380.0)
+    assert c["t"][0] == tE and c["t"][1] == 100.5
+    assert math.remainder(c["heading"][0] - (math.pi - 0.0015 + 0.001 * (tE - 99.5)), 2 * math.pi) == \
+        pytest.approx(0.0, abs=1e-12)
+    assert c["u_r"][0] == pytest.approx(U0, abs=1e-12)
+    exact = 0.9 * (UT - U0) / a
+    out = TM.speed_change(c["t"], c["x_w"], c["y_w"], c["heading"], c["u_r"], c["v_r"])
+    assert out["time_to_90_percent_s"] == pytest.approx(exact, abs=1e-6)
+    w = (t >= tE) & (t <= 380.0)
+    old = TM.speed_change(t[w], x[w], 0 * t[w], heading[w], u[w], 0 * t[w])
+    assert old["time_to_90_percent_s"] == pytest.approx(exact - 0.9 * 0.3, abs=1e-6)
+    # a sample exactly at EXECUTE: nothing inserted
+    assert from_execute(cols, 100.5, 380.0)["t"][0] == 100.5

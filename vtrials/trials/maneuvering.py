@@ -213,6 +213,34 @@ def execute(crew, run: Run, att) -> None:
     att.completed = done
 
 
+_ANGLES = ("heading", "wind_direction", "wind_apparent_angle")
+
+
+def from_execute(cols: dict, t_execute: float, t_end: float) -> dict:
+    """The truth columns over [EXECUTE, t_end], starting with a sample AT the EXECUTE instant. The
+    truth is stored every ``truth_every`` steps (0.5 s on the patrol vessel's days) and EXECUTE falls
+    between samples: counted from the first sample after it, every time since EXECUTE came out short
+    by up to a sample interval — on the patrol vessel's time to 90 % of a speed change, an error of
+    0–0.45 s beside a measurement good to 0.2 s. The state at EXECUTE is carried on linearly from the
+    last two samples before it (the approach; angles along the shorter arc): interpolating toward the
+    sample after would mix in the maneuver's first response (a speed already rising)."""
+    t = cols["t"]
+    w = (t >= t_execute - 1e-9) & (t <= t_end + 1e-9)
+    c = {k: v[w] for k, v in cols.items()}
+    idx = np.flatnonzero(w)
+    if idx.size == 0 or idx[0] == 0 or t[idx[0]] - t_execute <= 1e-9:
+        return c
+    k = int(idx[0])
+    i0, i1 = (k - 2, k - 1) if k >= 2 else (k - 1, k)
+    a = (t_execute - t[i0]) / (t[i1] - t[i0])
+    for key, v in cols.items():
+        x0, x1 = float(v[i0]), float(v[i1])
+        d = math.remainder(x1 - x0, 2 * math.pi) if key in _ANGLES else x1 - x0
+        c[key] = np.concatenate([[x0 + a * d], c[key]])
+    c["t"][0] = t_execute
+    return c
+
+
 def maneuver_truth(run: Run, att, cols: dict) -> dict:
     """Truth references of a maneuvering run from the true state (EXECUTE to FINEX, track through the
     water), by the definitions of :mod:`vtrials.truth.metrics`; spirals: the true mean rate of turn and
@@ -220,8 +248,11 @@ def maneuver_truth(run: Run, att, cols: dict) -> dict:
     p = run.params
     t = cols["t"]
     w = (t >= att.t_execute - 1e-9) & (t <= att.t_finex + 1e-9)
-    c = {k: v[w] for k, v in cols.items()}
     kind = p["type"]
+    # maneuvers timed from EXECUTE start at its instant; the spirals' and steady runs' windows are
+    # means over the data, which an interpolated sample would only weigh differently
+    c = from_execute(cols, att.t_execute, att.t_finex) if kind in ("turn", "pull_out", "zigzag", "speed_change") \
+        else {k: v[w] for k, v in cols.items()}
     out: dict = {"type": kind}
     if c["t"].size < 3:
         return out
@@ -247,8 +278,9 @@ def maneuver_truth(run: Run, att, cols: dict) -> dict:
         # threshold), the reduction's definition
         psi = np.unwrap(cols["heading"])
         ma = (t >= getattr(att, "t_comex", att.t_execute - 60.0) - 1e-9) & (t <= att.t_execute + 1e-9)
-        k0 = int(np.flatnonzero(w)[0])
-        base = float(np.mean(psi[ma])) - float(psi[k0]) + float(c["heading"][0]) if np.any(ma) else None
+        # the approach's mean heading on the branch of the heading at EXECUTE, c["heading"][0]
+        base = (float(np.mean(psi[ma])) - float(np.interp(att.t_execute, t, psi)) + float(c["heading"][0])
+                if np.any(ma) else None)
         side = 1 if p["rudder"] > 0 else -1
         rudders = [k for k in c if re.fullmatch(r"rudder_\d+", k)]
         rud = np.mean([c[k] for k in rudders], axis=0) if rudders else None
