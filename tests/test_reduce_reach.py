@@ -289,18 +289,19 @@ def test_velocity_crossing_unbiased_at_the_knee():
 
 
 def test_ninety_percent_from_a_standing_start_with_leeway_on_the_receivers_velocity():
-    """A ship waiting with engines stopped drifts 0.6 m/s abeam with 0.02 m/s ahead, then accelerates
+    """A ship waiting with engines stopped drifts 0.6 m/s abeam with 0.03 m/s astern, then accelerates
     (u = U_T − (U_T − u₀)e^{−kt}, the drift ceasing at EXECUTE); the receiver's Doppler velocity
-    (0.05 m/s white noise at 2 Hz) gives the 90 % instant. The level's U₀ is the references'
-    sign(u)·|V| = +0.6 m/s; from the sample-by-sample sign of a 2-cm/s surge it came out anywhere in
-    ±0.6 m/s and the instant 1–2 s off. Over 60 runs: unbiased, and the interval covers."""
+    (0.05 m/s white noise at 2 Hz) gives the 90 % instant. The level's U₀ is the references' signed
+    speed, +|V| = +0.6 m/s (no sternway: u above −0.1 m/s); from the sample-by-sample sign of a few
+    cm/s of surge it came out anywhere in ±0.6 m/s and the instant 1–3 s off. Over 60 runs: unbiased,
+    and the interval covers."""
     class Beam(Accel):
         def y(self, t):
             t = np.asarray(t, float)
             return np.where(t < 0, 0.6 * t, 0.0)
 
-    run = Beam(u0=0.02, uT=8.0, k=0.05)
-    U0 = math.hypot(0.02, 0.6)
+    run = Beam(u0=-0.03, uT=8.0, k=0.05)
+    U0 = math.hypot(0.03, 0.6)
     level = U0 + 0.9 * (run.uT - U0)
     exact = -math.log((run.uT - level) / (run.uT - run.u0)) / run.k
     rng = np.random.default_rng(8)

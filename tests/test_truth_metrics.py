@@ -142,3 +142,10 @@ def test_times_are_counted_from_the_execute_instant_between_truth_samples():
     assert old["time_to_90_percent_s"] == pytest.approx(exact - 0.9 * 0.3, abs=1e-6)
     # a sample exactly at EXECUTE: nothing inserted
     assert from_execute(cols, 100.5, 380.0)["t"][0] == 100.5
+
+
+def test_signed_speed_is_astern_only_with_clear_sternway():
+    """|V| signed by the surge only below −0.1 m/s: a stopped ship drifting 0.7 m/s abeam with a
+    surge of ±3 cm/s has +0.7 m/s either way; going astern at 2 m/s it is −|V|."""
+    U = TM.signed_speed([0.03, -0.03, -0.099, -2.0, 5.0], [0.7, 0.7, 0.0, 0.5, 0.0])
+    assert U == pytest.approx([math.hypot(0.03, 0.7), math.hypot(0.03, 0.7), 0.099, -math.hypot(2.0, 0.5), 5.0])

@@ -81,6 +81,9 @@ from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_infla
 
 
 # --------------------------------------------------------------------------------------------- helpers
+
+STERNWAY_MPS = 0.1  # astern only with a surge below −0.1 m/s (the references' rule: truth.metrics.signed_speed)
+
 def _line(t, y):
     """OLS y = a + b (t − t̄) → (a, b, SE(a), SE(b), t̄) with the residual σ."""
     tm = float(np.mean(t))
@@ -292,7 +295,7 @@ def _metrics(tg, s, y, vs, vy, dpsi_g, U0, tail_t, s_tail, y_tail, band_fraction
     EXECUTE) from the position fit; speeds vs, vy from the speed fit."""
     u = vs if dpsi_g is None else vs * np.cos(dpsi_g) + vy * np.sin(dpsi_g)
     V = np.hypot(vs, vy)
-    U = np.where(u >= 0, 1.0, -1.0) * V
+    U = np.where(u < -STERNWAY_MPS, -1.0, 1.0) * V
     out = {"s": s, "y": y, "u": u, "U": U}
     # path length = reach along the approach course (position fit) + ∫(|V| − ṡ) dt from the speed
     # fit: the excess is second order in the lateral motion, and taking it from the smoother fit
@@ -433,7 +436,7 @@ def _water_track_instants(res, base, tg, water, t_execute, t_end, approach_s, U0
     tw, uw, vw = tw[ok], uw[ok], vw[ok]
     if tw.size < 20:
         return
-    Uw = np.where(uw >= 0, 1.0, -1.0) * np.hypot(uw, vw)
+    Uw = np.where(uw < -STERNWAY_MPS, -1.0, 1.0) * np.hypot(uw, vw)
     # the log is noisier than a receiver's Doppler (0.1 m/s at 2 Hz): crossings from 10-s running means
     # refined by quadratics over ±hw, hw the larger of 3.5 s and the time the speed takes to change by
     # twice the noise at the run's mean acceleration (a slow ship's crossings are smooth and shallow)
@@ -446,7 +449,12 @@ def _water_track_instants(res, base, tg, water, t_execute, t_end, approach_s, U0
     tail = tw >= t_end - max(tail_fraction * run, 5.0)
     if np.count_nonzero(app) < 3 or np.count_nonzero(tail) < 3:
         return
-    U0, sU0 = _mean_se(Uw[app])
+    # U0 from the approach's mean velocity through the water: magnitude, astern only with clear
+    # sternway (a stopped ship's leeway with a surge of a few cm/s either way is +|V|)
+    (ua, sua), (va, sva) = _mean_se(uw[app]), _mean_se(vw[app])
+    V0w = math.hypot(ua, va)
+    U0 = -V0w if ua < -STERNWAY_MPS else V0w
+    sU0 = math.hypot(ua * sua, va * sva) / V0w if V0w > 0 else math.hypot(sua, sva)
     UT, sUT = _mean_se(Uw[tail])
     res.terminal_speed = Estimate(UT, math.hypot(sUT, scale_sd * UT))
     notes.append("speeds through the water (terminal, 90 %, band, dead in the water) on the water-track log")
@@ -562,13 +570,14 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         notes.append("approach course from the approach track (no gyro)")
     uvec = np.array([math.cos(psi0), math.sin(psi0)])
     nvec = np.array([-math.sin(psi0), math.cos(psi0)])
-    # approach speed through the water: the magnitude of the corrected approach velocity, signed by its
-    # component along the approach course — the track speed U of the curve below and the references'
-    # speed (sign(u)·|V|); a ship waiting stopped drifts sideways in the wind, where the component
-    # along the course alone would miss that speed (the patrol vessel's standing start: 0.7 m/s)
+    # approach speed through the water: the magnitude of the corrected approach velocity, negative only
+    # with clear sternway along the approach course — the track speed U of the curve below and the
+    # references' signed speed (truth.metrics.signed_speed); a ship waiting stopped drifts sideways in
+    # the wind, where the component along the course alone would miss that speed (the patrol vessel's
+    # standing start: 0.7 m/s)
     V0 = math.hypot(bN, bE)
     evec = np.array([bN, bE]) / V0 if V0 > 0.0 else uvec
-    U0 = math.copysign(V0, float(uvec @ [bN, bE]))
+    U0 = -V0 if float(uvec @ [bN, bE]) < -STERNWAY_MPS else V0
     var_fix_app = slope_variance(tp[ma], fix_errors)
     var_drift_u = float(uvec @ SD @ uvec)
     U0_se = math.sqrt((evec[0] * sbN) ** 2 + (evec[1] * sbE) ** 2 + var_fix_app + float(evec @ SD @ evec))
@@ -701,7 +710,7 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         if tv.size >= 20:
             psi_v = np.interp(tv, th, hd) if hd is not None else np.full(tv.size, psi0)
             u_v = vN * np.cos(psi_v) + vE * np.sin(psi_v)  # surge through the water
-            vel = (tv, u_v, np.where(u_v >= 0, 1.0, -1.0) * np.hypot(vN, vE), vN, vE)
+            vel = (tv, u_v, np.where(u_v < -STERNWAY_MPS, -1.0, 1.0) * np.hypot(vN, vE), vN, vE)
     if "t_diw" in base:
         td = base["t_diw"]
         sD_u = math.sqrt(float(uvec @ SD @ uvec))
@@ -798,16 +807,16 @@ def reach_analysis(t, north, east, t_execute: float, *, heading=None, t_heading=
         ma_ = (tv_ >= t_execute - approach_s) & (tv_ <= t_execute)
         mT = tv_ >= t_end - max(tail_fraction * run, 5.0)
         if np.count_nonzero(m0) >= 3 and np.count_nonzero(mT) >= 3:
-            # U0 from the mean velocity through the water over the last 5 s (magnitude) and the sign
-            # of the whole approach's mean surge: near rest with a leeway drift the sample-by-sample
-            # sign of a surge of a few cm/s flips with the receiver's noise, and a mean of signed
-            # speeds lands anywhere between ±|v|
+            # U0 from the mean velocity through the water over the last 5 s (magnitude), negative
+            # only if the approach's mean surge is clearly astern (below −STERNWAY_MPS, the
+            # reference's rule, vtrials.truth.metrics.signed_speed): near rest with a leeway drift the
+            # sign of a surge of a few cm/s flips with the receiver's noise and the current's error
             (n0, sn0), (e0, se0) = (_mean_se(x[m0]) for x in (vel[3], vel[4]))
             u0, su0 = _mean_se(vel[1][ma_])
             V0 = math.hypot(n0, e0)
-            U0v = math.copysign(V0, u0)
+            U0v = -V0 if u0 < -STERNWAY_MPS else V0
             sU0v = math.hypot(n0 * sn0, e0 * se0) / V0 if V0 > 0 else math.hypot(sn0, se0)
-            if abs(u0) < 2.0 * su0:  # the sign itself uncertain: the level moves by 0.1·2|U0|
+            if abs(u0 + STERNWAY_MPS) < 2.0 * su0:  # the sign itself uncertain: the level moves by 0.1·2|U0|
                 sU0v = math.hypot(sU0v, V0)
             UTv, sUTv = _mean_se(Uv_[mT])
             if abs(UTv - U0v) > 0:

@@ -233,8 +233,23 @@ def stopping(t, x_w, y_w, heading, u_r) -> dict:
     return out
 
 
+STERNWAY_MPS = 0.1  # a speed through the water counts as astern only with u below −0.1 m/s
+
+
+def signed_speed(u, v) -> np.ndarray:
+    """Speed through the water, negative with sternway: |V| = √(u² + v²), signed by the surge u only
+    where the ship clearly goes astern (u < −STERNWAY_MPS). A ship lying stopped drifts sideways in
+    the wind at up to ~1 m/s with a surge of a few cm/s either way; sign(u)·|V| then flipped the
+    initial speed of an acceleration from rest between ±|V| on a surge no trials team can resolve
+    against its current's uncertainty (a few cm/s). The reduction uses the same rule
+    (:mod:`vtrials.reduce.reach`)."""
+    u = np.asarray(u, float)
+    return np.where(u < -STERNWAY_MPS, -1.0, 1.0) * np.hypot(u, v)
+
+
 def speed_change(t, x_w, y_w, heading, u_r, v_r, *, settle_fraction: float = 0.02) -> dict:
-    """Acceleration / deceleration metrics from EXECUTE (index 0).
+    """Acceleration / deceleration metrics from EXECUTE (index 0), on the signed speed through the
+    water (:func:`signed_speed`).
 
     Terminal speed: mean speed through the water over the last 10 % of the run (at least the last
     5 s). time_to_terminal_speed_s: from EXECUTE until the speed enters, for good, the band
@@ -242,7 +257,7 @@ def speed_change(t, x_w, y_w, heading, u_r, v_r, *, settle_fraction: float = 0.0
     approach heading by then (track_distance_m along the water track).
     """
     t = np.asarray(t, float)
-    U = np.sign(u_r) * np.hypot(u_r, v_r)
+    U = signed_speed(u_r, v_r)
     along, _ = _axes(x_w, y_w, heading)
     path = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x_w), np.diff(y_w)))])
     n_last_5s = len(t) - int(np.searchsorted(t, t[-1] - 5.0))
