@@ -569,10 +569,25 @@ def curve_power(curve: dict, v) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------- log calibration
-def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
+def _current_basis(t, model, t_ref: float, span: float):
+    """The time functions of the current model of the log-calibration fits, their names and the factor
+    that turns the fit's coefficients into the reported ones. ``model`` 0–2: a polynomial of that degree
+    in (t − t_ref)/span (coefficients reported per second^k); ``"tidal"``: a steady stream plus the
+    principal semidiurnal tide, 1, cos ω(t − t_ref), sin ω(t − t_ref) with ω = 2π/12.42 h (the current
+    model of the ITTC iterative method, ITTC 7.5-04-01-01.1 (2017), without its linear trend; m/s)."""
+    tt = np.asarray(t, float) - t_ref
+    if model == "tidal":
+        w = 2.0 * math.pi / CUR.TIDAL_PERIOD
+        return [np.ones_like(tt), np.cos(w * tt), np.sin(w * tt)], ["0", "cos", "sin"], np.ones(3)
+    k = np.arange(int(model) + 1)
+    return [(tt / span) ** j for j in k], [str(j) for j in k], span ** -k.astype(float)
+
+
+def _joint_current_fit(t, heading, vg, vg_std, group, order, reading=None, ratio=None):
     """|U_i h(ψ_i) + c(t_i)| least squares: the legs' speeds through water U_i, and the current c =
-    (c_N, c_E), a polynomial of degree ``order`` (0–2) in time about the mean leg time, coefficients per
-    second^k. ψ_i is the direction of the leg's water track (its course plus the measured drift angle,
+    (c_N, c_E) in time (:func:`_current_basis`: ``order`` 0–2, a polynomial of that degree about the
+    mean leg time, coefficients per second^k; ``"tidal"``, steady stream plus semidiurnal tide). ψ_i is
+    the direction of the leg's water track (its course plus the measured drift angle,
     :func:`_leg_drift`).
 
     Without ``reading``, U_i = U_g, one unknown per group. With ``reading`` (a log's mean reading per
@@ -580,6 +595,14 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     calibration line solved inside the current fit, so each leg's own speed through water (head or
     tail wind moves it, and the log sees it) enters, and the line's uncertainty comes from the legs'
     tracking errors through the same fit; legs without a reading keep a U per group.
+
+    With ``ratio`` (per leg, the ratio of a log's mean reading on the leg to its mean over the leg's
+    group), a group's legs take U_i = U_g · ratio_i: at constant shaft speed a leg into the wind is
+    slower through the water than one with it (±3 % on KVLCC2 in 15 kn, the big ship still settling an
+    hour after the turn), and the log sees it, its scale error cancelling in the ratio. U_g is then the
+    speed through water at the group's mean reading — the mean of the legs' speeds, the reference of a
+    group's speed (:func:`vtrials.score.trials.score_log_calibration`) — and the leg-to-leg change no
+    longer passes for scatter (τ) or for current.
 
     Legs weighed by 1/(σᵢ² + τ²), τ the scatter beyond the tracking's stated σ that makes χ² = dof
     (:func:`vtrials.reduce.current.ship_scatter`: the ship's own leg-to-leg speed changes for the
@@ -596,19 +619,22 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     G = len(groups)
     tm = float(np.mean(t))
     span = max(float(np.ptp(t)), 1.0)
-    tau_t = (t - tm) / span
+    basis, suffix, scale = _current_basis(t, order, tm, span)
+    nb = len(basis)
     hc, hs = np.cos(heading), np.sin(heading)
+    rr = np.ones(vg.size) if ratio is None else np.asarray(ratio, float)
 
     def model(x):
-        U = x[ncal:ncal + G][np.maximum(gi, 0)] if G else np.zeros(vg.size)
+        U = x[ncal:ncal + G][np.maximum(gi, 0)] * rr if G else np.zeros(vg.size)
         if ncal:
             U = np.where(has, x[0] + x[1] * rd, U)
         c = x[ncal + G:]
-        cn = sum(c[2 * k] * tau_t ** k for k in range(order + 1))
-        ce = sum(c[2 * k + 1] * tau_t ** k for k in range(order + 1))
+        cn = sum(c[2 * k] * basis[k] for k in range(nb))
+        ce = sum(c[2 * k + 1] * basis[k] for k in range(nb))
         return np.hypot(U * hc + cn, U * hs + ce)
 
-    x0 = np.concatenate([[0.0, 1.0][:ncal], [np.mean(vg[gi == k]) for k in range(G)], np.zeros(2 * (order + 1))])
+    x0 = np.concatenate([[0.0, 1.0][:ncal], [np.mean(vg[gi == k] / rr[gi == k]) for k in range(G)],
+                         np.zeros(2 * nb)])
     if ncal:  # start the line from the plain regression of ground speed on reading
         x0[:2] = np.polyfit(rd[has], vg[has], 1)[::-1] if np.ptp(rd[has]) > 0 else (0.0, 1.0)
     n, p = vg.size, x0.size
@@ -623,10 +649,10 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     tau, (w, J, x, r, chi2) = CUR.ship_scatter(solve, fit0[4], dof, fit0[3], vg_std)
     cov = np.linalg.pinv(J.T @ J)
     A = np.linalg.pinv(J) * w[None, :]
-    # the current's coefficients per second^k (the fit's are per span^k)
-    unit = np.concatenate([np.ones(ncal + G), np.repeat(span ** -np.arange(order + 1.0), 2)])
+    # the polynomial current's coefficients per second^k (the fit's are per span^k)
+    unit = np.concatenate([np.ones(ncal + G), np.repeat(scale, 2)])
     names = ["intercept", "slope"][:ncal] + [f"U[{g}]" for g in groups] + \
-        [f"{c}_{k}" for k in range(order + 1) for c in ("north", "east")]
+        [f"{c}_{k}" for k in suffix for c in ("north", "east")]
     return {"names": names, "x": x * unit, "cov": cov * np.outer(unit, unit), "A": A * unit[:, None],
             "dof": dof, "t_ref": tm, "residuals": r, "tau": tau, "groups": groups, "chi2": chi2}
 
@@ -780,7 +806,7 @@ def reduce_log_calibration(rec: Record) -> dict:
     return out
 
 
-def resolve_current(t, heading, vg, vg_std, group, drift=None):
+def resolve_current(t, heading, vg, vg_std, group, drift=None, ratio=None):
     """Speed through water per group and the current from the legs' ground speeds, or the reason they
     cannot be resolved.
 
@@ -794,7 +820,15 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None):
     reciprocal pair's ground speeds (the along-axis current cancels; seed 000 eq. 3), or the four-leg
     closed form (seed 000 App. A); a group with neither is under-determined too. ``heading`` is each
     leg's course, which sets the geometry (the axes and the rank); ``drift`` [rad] its measured drift
-    angle, so that the fit takes the water track along heading + drift.
+    angle, so that the fit takes the water track along heading + drift; ``ratio`` each leg's log reading
+    over its group's mean reading (:func:`_joint_current_fit`), None to take the group's legs equal.
+
+    The current's change in time: over a day shorter than half the semidiurnal period (12.42 h) the
+    richest polynomial (quadratic, linear, constant) that leaves at least 3 legs over; over a longer day
+    (a VLCC's: an hour to settle after every turn, 14 legs in 16 h) the steady stream plus the
+    semidiurnal tide (the ITTC iterative method's model without its trend), which a quadratic cannot
+    follow through more than half a period, and which, on less than half a period, is too close to a
+    polynomial to be told apart from it.
 
     Returns (groups, U {group: Estimate | None}, current dict, fit dict, under-determined list).
     """
@@ -806,22 +840,26 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None):
     tm = float(np.mean(t))
 
     def design(order):
-        tt = (t - tm) / max(float(np.ptp(t)), 1.0)
+        basis = _current_basis(t, order, tm, max(float(np.ptp(t)), 1.0))[0]
         cols = [(gi == k).astype(float) for k in range(G)]
-        for k in range(order + 1):
-            cols += [np.cos(heading) * tt ** k, np.sin(heading) * tt ** k]
+        for b in basis:
+            cols += [np.cos(heading) * b, np.sin(heading) * b]
         return np.column_stack(cols)
 
-    # the current's change with time: the richest polynomial (quadratic: a tide's curvature over a
-    # few hours; linear; constant) that leaves at least 3 legs over and is resolved by the legs
-    order = next((k for k in (2, 1) if n - (G + 2 * (k + 1)) >= 3
-                  and np.linalg.matrix_rank(design(k)) == G + 2 * (k + 1)), 0)
-    trend = order >= 1
-    p = G + 2 * (order + 1)
+    def npar(order):
+        return G + 2 * len(_current_basis(t[:1], order, tm, 1.0)[0])
+
+    # the current's change with time: over a long day the steady stream plus the semidiurnal tide, else
+    # the richest polynomial (quadratic: a tide's curvature over a few hours; linear; constant), the
+    # first that leaves at least 3 legs over and is resolved by the legs
+    models = (("tidal",) if np.ptp(t) >= 0.5 * CUR.TIDAL_PERIOD else ()) + (2, 1)
+    order = next((k for k in models if n - npar(k) >= 3 and np.linalg.matrix_rank(design(k)) == npar(k)), 0)
+    trend = order != 0
+    p = npar(order)
     rank = int(np.linalg.matrix_rank(design(order)))
     if n > p and rank == p:
         track = heading if drift is None else heading + np.asarray(drift, dtype=float)
-        f = _joint_current_fit(t, track, vg, vg_std, group, order)
+        f = _joint_current_fit(t, track, vg, vg_std, group, order, ratio=ratio)
         x, cov, dof, tau = f["x"], f["cov"], f["dof"], f["tau"]
         sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
         # the groups' speeds carry τ in full (normal quantile): τ stands for the ship's leg-to-leg scatter
@@ -831,10 +869,12 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None):
         cur = {"north": Estimate(float(x[G]), float(sd[G])),
                "east": Estimate(float(x[G + 1]), float(sd[G + 1])), "trend": trend, "order": order,
                "t_ref": f["t_ref"]}
-        for k, name in ((1, "rate"), (2, "accel")):
-            if order >= k:
-                cur[f"north_{name}"] = Estimate(float(x[G + 2 * k]), float(sd[G + 2 * k]))
-                cur[f"east_{name}"] = Estimate(float(x[G + 2 * k + 1]), float(sd[G + 2 * k + 1]))
+        terms = ((1, "cos"), (2, "sin")) if order == "tidal" else ((1, "rate"), (2, "accel"))
+        for k, name in terms[:(p - G) // 2 - 1]:
+            cur[f"north_{name}"] = Estimate(float(x[G + 2 * k]), float(sd[G + 2 * k]))
+            cur[f"east_{name}"] = Estimate(float(x[G + 2 * k + 1]), float(sd[G + 2 * k + 1]))
+        if order == "tidal":
+            cur["tidal_period_s"] = CUR.TIDAL_PERIOD
         return groups, U, cur, {"dof": dof, "residuals": f["residuals"], "trend": trend, "order": order,
                                 "ship_scatter": tau}, []
     if rank < p:
