@@ -102,8 +102,21 @@ def accepted_runs(rec: Record) -> list[dict]:
     return sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
 
 
-def run_statistics(rec: Record, run: dict) -> dict:
-    """Everything the team tabulates for one run window [EXECUTE, FINEX] (SI units)."""
+# the angle at which two lines of position may cross for a fix to be accepted (hydrographic practice for
+# two-range and two-angle fixes: between 30 and 150 deg; NOAA Office of Coast Survey, Field Procedures
+# Manual; IHO C-13 Manual on Hydrography ch. 2)
+FIX_CUT_DEG = (30.0, 150.0)
+
+
+def run_statistics(rec: Record, run: dict, min_cut: bool = False) -> dict:
+    """Everything the team tabulates for one run window [EXECUTE, FINEX] (SI units).
+
+    ``min_cut``: a range–range radar whose two range lines cross at less than 30° or more than 150°
+    somewhere in the window (:data:`FIX_CUT_DEG`; its ``crossing_angle`` channel) is not taken as the
+    run's tracking (its statistics are still listed): near the baseline through the two stations the
+    fix loses its geometry and, on crossing it, jumps to the mirror side — a 320-m tanker's 16-h day
+    wanders ±35 km and crosses a shore pair's baseline 20 km off (SOG errors to 3 m/s, 50 times the
+    stated σ, on 3 of 24 KVLCC2 trial days); the next system in :data:`TRACKING_PREFERENCE` tracks it."""
     t0, t1 = run["t_execute"], run["t_finex"]
     kinds = _by_kind(rec)
     channels = {}
@@ -143,7 +156,19 @@ def run_statistics(rec: Record, run: dict) -> dict:
             out["sog"][name] = {"sog": _est(RS.sog_from_displayed(tu, vu, t0, t1)), "kind": "loran"}
         except ValueError:
             pass
-    primary = next((n for k in TRACKING_PREFERENCE for n in kinds.get(k, []) if n in out["sog"]), None)
+    def usable(name):
+        if not min_cut or out["sog"][name]["kind"] != "range_radar" or "crossing_angle" not in rec.channels(name):
+            return True
+        tc, cut = rec.channel(name, "crossing_angle")
+        w = (tc >= t0) & (tc <= t1)
+        c = np.degrees(cut[w])
+        ok = bool(c.size) and bool(np.all(np.isfinite(c))) and FIX_CUT_DEG[0] <= c.min() and c.max() <= FIX_CUT_DEG[1]
+        if not ok:
+            out["notes"] = out["notes"] + [f"{name}: range lines cross outside {FIX_CUT_DEG[0]:g}-"
+                                           f"{FIX_CUT_DEG[1]:g} deg in the window; not used for tracking"]
+        return ok
+
+    primary = next((n for k in TRACKING_PREFERENCE for n in kinds.get(k, []) if n in out["sog"] and usable(n)), None)
     if primary is None:
         raise ValueError(f"run {run['run']}: no tracking fixes in the window")
     out["tracking"] = primary
@@ -678,7 +703,7 @@ def _leg_drift(runs: list[dict], kinds: dict) -> tuple[np.ndarray, str]:
 
 
 def reduce_log_calibration(rec: Record) -> dict:
-    runs = [run_statistics(rec, r) for r in accepted_runs(rec)]
+    runs = [run_statistics(rec, r, min_cut=True) for r in accepted_runs(rec)]
     kinds = _by_kind(rec)
     t = np.array([r["t_mid"] for r in runs])
     hd = np.array([r["course"] for r in runs])
@@ -686,7 +711,15 @@ def reduce_log_calibration(rec: Record) -> dict:
     grp = [r["group"] for r in runs]
     vs = np.array([r["vg"].std for r in runs])
     drift, drift_source = _leg_drift(runs, kinds)
-    groups, U, cur, fit, under = resolve_current(t, hd, vg, vs, grp, drift=drift)
+    # each leg's speed through water relative to its group's, from a log's relative readings
+    ratio, ratio_source = np.ones(len(runs)), None
+    for g in sorted(set(grp)):
+        sel = [i for i, x in enumerate(grp) if x == g]
+        f = _log_speed_factor([runs[i] for i in sel], kinds, 1.0) if len(sel) > 1 else None
+        if f is not None:
+            ratio[sel] = f
+            ratio_source = "log readings"
+    groups, U, cur, fit, under = resolve_current(t, hd, vg, vs, grp, drift=drift, ratio=ratio)
     dof, resid = fit["dof"], fit["residuals"]
     # classic cross-checks per group: the four-leg closed form and the reciprocal-pair shortcut
     classic = {}
@@ -859,7 +892,11 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None, ratio=None):
     rank = int(np.linalg.matrix_rank(design(order)))
     if n > p and rank == p:
         track = heading if drift is None else heading + np.asarray(drift, dtype=float)
-        f = _joint_current_fit(t, track, vg, vg_std, group, order, ratio=ratio)
+        f = _joint_current_fit(t, track, vg, vg_std, group, order)
+        if ratio is not None:  # the log's relative readings, where they explain the legs better
+            fr = _joint_current_fit(t, track, vg, vg_std, group, order, ratio=ratio)
+            if (fr["tau"], fr["chi2"]) < (f["tau"], f["chi2"]):
+                f = fr
         x, cov, dof, tau = f["x"], f["cov"], f["dof"], f["tau"]
         sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
         # the groups' speeds carry τ in full (normal quantile): τ stands for the ship's leg-to-leg scatter
