@@ -702,6 +702,17 @@ def _leg_drift(runs: list[dict], kinds: dict) -> tuple[np.ndarray, str]:
     return np.zeros(len(runs)), "not measured (no water-track Doppler log): water track taken along the course"
 
 
+def _reading_noise(runs: list[dict], name: str, reading) -> float:
+    """Standard error [reading units] of one leg's mean reading of log ``name``: the root mean square of
+    the legs' own standard errors (:func:`vtrials.reduce.runstats.channel_stats`, autocorrelation
+    counted) over the legs with a reading — pooled, because a 300-s wander leaves one 10-min leg only
+    one or two independent looks at it."""
+    se = [((r["channels"].get(name) or {}).get("speed") or {}).get("se") for r, x in zip(runs, reading)
+          if math.isfinite(x)]
+    se = [x for x in se if x is not None and math.isfinite(x)]
+    return math.sqrt(float(np.mean(np.square(se)))) if se else 0.0
+
+
 def reduce_log_calibration(rec: Record) -> dict:
     runs = [run_statistics(rec, r, min_cut=True) for r in accepted_runs(rec)]
     kinds = _by_kind(rec)
@@ -787,12 +798,19 @@ def reduce_log_calibration(rec: Record) -> dict:
             continue
         reading = np.array([np.nan if (leg.get(f"{name}_speed") is None or leg[f"{name}_speed"] <= 0.0)
                             else leg[f"{name}_speed"] for leg in legs])
-        jf = _joint_current_fit(t, hd + drift, vg, vs, grp, fit["order"], reading=reading)
+        # each leg's mean reading has its own error (the log's wander over the leg), measured from the
+        # readings within the legs (their standard errors, pooled over the day: one leg's is too rough):
+        # a known part of every leg's scatter about the line, on top of its tracking σ
+        u_read = _reading_noise(runs, name, reading)
+        has = np.isfinite(reading)
+        k0 = np.polyfit(reading[has], vg[has], 1)[0] if np.ptp(reading[has]) > 0 else 1.0
+        vs_cal = np.sqrt(vs ** 2 + np.where(has, (k0 * u_read) ** 2, 0.0))
+        jf = _joint_current_fit(t, hd + drift, vg, vs_cal, grp, fit["order"], reading=reading)
         b, C = jf["x"][:2], jf["cov"][:2, :2]
         sd = np.sqrt(np.diag(C))
         # dof of each coefficient: Welch–Satterthwaite, the τ part (found from the fit's residuals) on the
         # fit's dof — the EM log's 300-s wander makes τ the larger part, estimated from 8–10 dof
-        nu = [CUR.scatter_budget(jf["A"][k], vs, jf["tau"], np.zeros(vs.size), jf["dof"])[1] for k in (0, 1)]
+        nu = [CUR.scatter_budget(jf["A"][k], vs_cal, jf["tau"], np.zeros(vs.size), jf["dof"])[1] for k in (0, 1)]
         se = np.sqrt(np.maximum(C[0, 0] + 2.0 * xs * C[0, 1] + xs ** 2 * C[1, 1], 0.0))
         line = b[0] + b[1] * xs
         fitted = b[0] + b[1] * xr
