@@ -10,6 +10,7 @@ machine hold byte for byte on an Intel Xeon one, so the platform is information,
 nothing else changed, regenerate them with
 
     python tests/pins.py --update          # runs every shipped scenario (a few minutes)
+    python tests/pins.py --update NAME ...  # only the named scenarios (file stems); the others' pins kept
 """
 
 from __future__ import annotations
@@ -76,9 +77,21 @@ def main(argv: list[str]) -> int:
     if "--update" not in argv:
         print(__doc__)
         return 2
-    pins = {"platform": platform_tag(), "outputs": {}}
+    names = [a for a in argv if a != "--update"]
+    known = {s.stem for s in scenarios()}
+    unknown = sorted(set(names) - known)
+    if unknown:
+        print(f"no shipped scenario named {', '.join(unknown)} (scenarios/*.toml stems)")
+        return 2
+    if names:  # only these: the other scenarios keep their pins (made on the platform the file names)
+        pins = json.loads(PINS.read_text())
+        pins["outputs"] = {k: v for k, v in pins["outputs"].items() if k in known}
+        if pins["platform"] != platform_tag():
+            print(f"note: the other pins were made on {pins['platform']!r}, this is {platform_tag()!r}")
+    else:
+        pins = {"platform": platform_tag(), "outputs": {}}
     with tempfile.TemporaryDirectory() as tmp:
-        for s in scenarios():
+        for s in [s for s in scenarios() if not names or s.stem in names]:
             pins["outputs"][s.stem] = run_and_fingerprint(s, Path(tmp) / s.stem)
             print(s.stem, "pinned", flush=True)
     PINS.write_text(json.dumps(pins, indent=1, sort_keys=True) + "\n")

@@ -102,8 +102,21 @@ def accepted_runs(rec: Record) -> list[dict]:
     return sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
 
 
-def run_statistics(rec: Record, run: dict) -> dict:
-    """Everything the team tabulates for one run window [EXECUTE, FINEX] (SI units)."""
+# the angle at which two lines of position may cross for a fix to be accepted (hydrographic practice for
+# two-range and two-angle fixes: between 30 and 150 deg; NOAA Office of Coast Survey, Field Procedures
+# Manual; IHO C-13 Manual on Hydrography ch. 2)
+FIX_CUT_DEG = (30.0, 150.0)
+
+
+def run_statistics(rec: Record, run: dict, min_cut: bool = False) -> dict:
+    """Everything the team tabulates for one run window [EXECUTE, FINEX] (SI units).
+
+    ``min_cut``: a range–range radar whose two range lines cross at less than 30° or more than 150°
+    somewhere in the window (:data:`FIX_CUT_DEG`; its ``crossing_angle`` channel) is not taken as the
+    run's tracking (its statistics are still listed): near the baseline through the two stations the
+    fix loses its geometry and, on crossing it, jumps to the mirror side — a 320-m tanker's 16-h day
+    wanders ±35 km and crosses a shore pair's baseline 20 km off (SOG errors to 3 m/s, 50 times the
+    stated σ, on 3 of 24 KVLCC2 trial days); the next system in :data:`TRACKING_PREFERENCE` tracks it."""
     t0, t1 = run["t_execute"], run["t_finex"]
     kinds = _by_kind(rec)
     channels = {}
@@ -143,7 +156,19 @@ def run_statistics(rec: Record, run: dict) -> dict:
             out["sog"][name] = {"sog": _est(RS.sog_from_displayed(tu, vu, t0, t1)), "kind": "loran"}
         except ValueError:
             pass
-    primary = next((n for k in TRACKING_PREFERENCE for n in kinds.get(k, []) if n in out["sog"]), None)
+    def usable(name):
+        if not min_cut or out["sog"][name]["kind"] != "range_radar" or "crossing_angle" not in rec.channels(name):
+            return True
+        tc, cut = rec.channel(name, "crossing_angle")
+        w = (tc >= t0) & (tc <= t1)
+        c = np.degrees(cut[w])
+        ok = bool(c.size) and bool(np.all(np.isfinite(c))) and FIX_CUT_DEG[0] <= c.min() and c.max() <= FIX_CUT_DEG[1]
+        if not ok:
+            out["notes"] = out["notes"] + [f"{name}: range lines cross outside {FIX_CUT_DEG[0]:g}-"
+                                           f"{FIX_CUT_DEG[1]:g} deg in the window; not used for tracking"]
+        return ok
+
+    primary = next((n for k in TRACKING_PREFERENCE for n in kinds.get(k, []) if n in out["sog"] and usable(n)), None)
     if primary is None:
         raise ValueError(f"run {run['run']}: no tracking fixes in the window")
     out["tracking"] = primary
@@ -569,10 +594,25 @@ def curve_power(curve: dict, v) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------- log calibration
-def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
+def _current_basis(t, model, t_ref: float, span: float):
+    """The time functions of the current model of the log-calibration fits, their names and the factor
+    that turns the fit's coefficients into the reported ones. ``model`` 0–2: a polynomial of that degree
+    in (t − t_ref)/span (coefficients reported per second^k); ``"tidal"``: a steady stream plus the
+    principal semidiurnal tide, 1, cos ω(t − t_ref), sin ω(t − t_ref) with ω = 2π/12.42 h (the current
+    model of the ITTC iterative method, ITTC 7.5-04-01-01.1 (2017), without its linear trend; m/s)."""
+    tt = np.asarray(t, float) - t_ref
+    if model == "tidal":
+        w = 2.0 * math.pi / CUR.TIDAL_PERIOD
+        return [np.ones_like(tt), np.cos(w * tt), np.sin(w * tt)], ["0", "cos", "sin"], np.ones(3)
+    k = np.arange(int(model) + 1)
+    return [(tt / span) ** j for j in k], [str(j) for j in k], span ** -k.astype(float)
+
+
+def _joint_current_fit(t, heading, vg, vg_std, group, order, reading=None, ratio=None):
     """|U_i h(ψ_i) + c(t_i)| least squares: the legs' speeds through water U_i, and the current c =
-    (c_N, c_E), a polynomial of degree ``order`` (0–2) in time about the mean leg time, coefficients per
-    second^k. ψ_i is the direction of the leg's water track (its course plus the measured drift angle,
+    (c_N, c_E) in time (:func:`_current_basis`: ``order`` 0–2, a polynomial of that degree about the
+    mean leg time, coefficients per second^k; ``"tidal"``, steady stream plus semidiurnal tide). ψ_i is
+    the direction of the leg's water track (its course plus the measured drift angle,
     :func:`_leg_drift`).
 
     Without ``reading``, U_i = U_g, one unknown per group. With ``reading`` (a log's mean reading per
@@ -580,6 +620,14 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     calibration line solved inside the current fit, so each leg's own speed through water (head or
     tail wind moves it, and the log sees it) enters, and the line's uncertainty comes from the legs'
     tracking errors through the same fit; legs without a reading keep a U per group.
+
+    With ``ratio`` (per leg, the ratio of a log's mean reading on the leg to its mean over the leg's
+    group), a group's legs take U_i = U_g · ratio_i: at constant shaft speed a leg into the wind is
+    slower through the water than one with it (±3 % on KVLCC2 in 15 kn, the big ship still settling an
+    hour after the turn), and the log sees it, its scale error cancelling in the ratio. U_g is then the
+    speed through water at the group's mean reading — the mean of the legs' speeds, the reference of a
+    group's speed (:func:`vtrials.score.trials.score_log_calibration`) — and the leg-to-leg change no
+    longer passes for scatter (τ) or for current.
 
     Legs weighed by 1/(σᵢ² + τ²), τ the scatter beyond the tracking's stated σ that makes χ² = dof
     (:func:`vtrials.reduce.current.ship_scatter`: the ship's own leg-to-leg speed changes for the
@@ -596,19 +644,22 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     G = len(groups)
     tm = float(np.mean(t))
     span = max(float(np.ptp(t)), 1.0)
-    tau_t = (t - tm) / span
+    basis, suffix, scale = _current_basis(t, order, tm, span)
+    nb = len(basis)
     hc, hs = np.cos(heading), np.sin(heading)
+    rr = np.ones(vg.size) if ratio is None else np.asarray(ratio, float)
 
     def model(x):
-        U = x[ncal:ncal + G][np.maximum(gi, 0)] if G else np.zeros(vg.size)
+        U = x[ncal:ncal + G][np.maximum(gi, 0)] * rr if G else np.zeros(vg.size)
         if ncal:
             U = np.where(has, x[0] + x[1] * rd, U)
         c = x[ncal + G:]
-        cn = sum(c[2 * k] * tau_t ** k for k in range(order + 1))
-        ce = sum(c[2 * k + 1] * tau_t ** k for k in range(order + 1))
+        cn = sum(c[2 * k] * basis[k] for k in range(nb))
+        ce = sum(c[2 * k + 1] * basis[k] for k in range(nb))
         return np.hypot(U * hc + cn, U * hs + ce)
 
-    x0 = np.concatenate([[0.0, 1.0][:ncal], [np.mean(vg[gi == k]) for k in range(G)], np.zeros(2 * (order + 1))])
+    x0 = np.concatenate([[0.0, 1.0][:ncal], [np.mean(vg[gi == k] / rr[gi == k]) for k in range(G)],
+                         np.zeros(2 * nb)])
     if ncal:  # start the line from the plain regression of ground speed on reading
         x0[:2] = np.polyfit(rd[has], vg[has], 1)[::-1] if np.ptp(rd[has]) > 0 else (0.0, 1.0)
     n, p = vg.size, x0.size
@@ -623,10 +674,10 @@ def _joint_current_fit(t, heading, vg, vg_std, group, order: int, reading=None):
     tau, (w, J, x, r, chi2) = CUR.ship_scatter(solve, fit0[4], dof, fit0[3], vg_std)
     cov = np.linalg.pinv(J.T @ J)
     A = np.linalg.pinv(J) * w[None, :]
-    # the current's coefficients per second^k (the fit's are per span^k)
-    unit = np.concatenate([np.ones(ncal + G), np.repeat(span ** -np.arange(order + 1.0), 2)])
+    # the polynomial current's coefficients per second^k (the fit's are per span^k)
+    unit = np.concatenate([np.ones(ncal + G), np.repeat(scale, 2)])
     names = ["intercept", "slope"][:ncal] + [f"U[{g}]" for g in groups] + \
-        [f"{c}_{k}" for k in range(order + 1) for c in ("north", "east")]
+        [f"{c}_{k}" for k in suffix for c in ("north", "east")]
     return {"names": names, "x": x * unit, "cov": cov * np.outer(unit, unit), "A": A * unit[:, None],
             "dof": dof, "t_ref": tm, "residuals": r, "tau": tau, "groups": groups, "chi2": chi2}
 
@@ -651,8 +702,19 @@ def _leg_drift(runs: list[dict], kinds: dict) -> tuple[np.ndarray, str]:
     return np.zeros(len(runs)), "not measured (no water-track Doppler log): water track taken along the course"
 
 
+def _reading_noise(runs: list[dict], name: str, reading) -> float:
+    """Standard error [reading units] of one leg's mean reading of log ``name``: the root mean square of
+    the legs' own standard errors (:func:`vtrials.reduce.runstats.channel_stats`, autocorrelation
+    counted) over the legs with a reading — pooled, because a 300-s wander leaves one 10-min leg only
+    one or two independent looks at it."""
+    se = [((r["channels"].get(name) or {}).get("speed") or {}).get("se") for r, x in zip(runs, reading)
+          if math.isfinite(x)]
+    se = [x for x in se if x is not None and math.isfinite(x)]
+    return math.sqrt(float(np.mean(np.square(se)))) if se else 0.0
+
+
 def reduce_log_calibration(rec: Record) -> dict:
-    runs = [run_statistics(rec, r) for r in accepted_runs(rec)]
+    runs = [run_statistics(rec, r, min_cut=True) for r in accepted_runs(rec)]
     kinds = _by_kind(rec)
     t = np.array([r["t_mid"] for r in runs])
     hd = np.array([r["course"] for r in runs])
@@ -660,7 +722,15 @@ def reduce_log_calibration(rec: Record) -> dict:
     grp = [r["group"] for r in runs]
     vs = np.array([r["vg"].std for r in runs])
     drift, drift_source = _leg_drift(runs, kinds)
-    groups, U, cur, fit, under = resolve_current(t, hd, vg, vs, grp, drift=drift)
+    # each leg's speed through water relative to its group's, from a log's relative readings
+    ratio, ratio_source = np.ones(len(runs)), None
+    for g in sorted(set(grp)):
+        sel = [i for i, x in enumerate(grp) if x == g]
+        f = _log_speed_factor([runs[i] for i in sel], kinds, 1.0) if len(sel) > 1 else None
+        if f is not None:
+            ratio[sel] = f
+            ratio_source = "log readings"
+    groups, U, cur, fit, under = resolve_current(t, hd, vg, vs, grp, drift=drift, ratio=ratio)
     dof, resid = fit["dof"], fit["residuals"]
     # classic cross-checks per group: the four-leg closed form and the reciprocal-pair shortcut
     classic = {}
@@ -728,12 +798,19 @@ def reduce_log_calibration(rec: Record) -> dict:
             continue
         reading = np.array([np.nan if (leg.get(f"{name}_speed") is None or leg[f"{name}_speed"] <= 0.0)
                             else leg[f"{name}_speed"] for leg in legs])
-        jf = _joint_current_fit(t, hd + drift, vg, vs, grp, fit["order"], reading=reading)
+        # each leg's mean reading has its own error (the log's wander over the leg), measured from the
+        # readings within the legs (their standard errors, pooled over the day: one leg's is too rough):
+        # a known part of every leg's scatter about the line, on top of its tracking σ
+        u_read = _reading_noise(runs, name, reading)
+        has = np.isfinite(reading)
+        k0 = np.polyfit(reading[has], vg[has], 1)[0] if np.ptp(reading[has]) > 0 else 1.0
+        vs_cal = np.sqrt(vs ** 2 + np.where(has, (k0 * u_read) ** 2, 0.0))
+        jf = _joint_current_fit(t, hd + drift, vg, vs_cal, grp, fit["order"], reading=reading)
         b, C = jf["x"][:2], jf["cov"][:2, :2]
         sd = np.sqrt(np.diag(C))
         # dof of each coefficient: Welch–Satterthwaite, the τ part (found from the fit's residuals) on the
         # fit's dof — the EM log's 300-s wander makes τ the larger part, estimated from 8–10 dof
-        nu = [CUR.scatter_budget(jf["A"][k], vs, jf["tau"], np.zeros(vs.size), jf["dof"])[1] for k in (0, 1)]
+        nu = [CUR.scatter_budget(jf["A"][k], vs_cal, jf["tau"], np.zeros(vs.size), jf["dof"])[1] for k in (0, 1)]
         se = np.sqrt(np.maximum(C[0, 0] + 2.0 * xs * C[0, 1] + xs ** 2 * C[1, 1], 0.0))
         line = b[0] + b[1] * xs
         fitted = b[0] + b[1] * xr
@@ -780,7 +857,7 @@ def reduce_log_calibration(rec: Record) -> dict:
     return out
 
 
-def resolve_current(t, heading, vg, vg_std, group, drift=None):
+def resolve_current(t, heading, vg, vg_std, group, drift=None, ratio=None):
     """Speed through water per group and the current from the legs' ground speeds, or the reason they
     cannot be resolved.
 
@@ -794,7 +871,15 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None):
     reciprocal pair's ground speeds (the along-axis current cancels; seed 000 eq. 3), or the four-leg
     closed form (seed 000 App. A); a group with neither is under-determined too. ``heading`` is each
     leg's course, which sets the geometry (the axes and the rank); ``drift`` [rad] its measured drift
-    angle, so that the fit takes the water track along heading + drift.
+    angle, so that the fit takes the water track along heading + drift; ``ratio`` each leg's log reading
+    over its group's mean reading (:func:`_joint_current_fit`), None to take the group's legs equal.
+
+    The current's change in time: over a day shorter than half the semidiurnal period (12.42 h) the
+    richest polynomial (quadratic, linear, constant) that leaves at least 3 legs over; over a longer day
+    (a VLCC's: an hour to settle after every turn, 14 legs in 16 h) the steady stream plus the
+    semidiurnal tide (the ITTC iterative method's model without its trend), which a quadratic cannot
+    follow through more than half a period, and which, on less than half a period, is too close to a
+    polynomial to be told apart from it.
 
     Returns (groups, U {group: Estimate | None}, current dict, fit dict, under-determined list).
     """
@@ -806,22 +891,30 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None):
     tm = float(np.mean(t))
 
     def design(order):
-        tt = (t - tm) / max(float(np.ptp(t)), 1.0)
+        basis = _current_basis(t, order, tm, max(float(np.ptp(t)), 1.0))[0]
         cols = [(gi == k).astype(float) for k in range(G)]
-        for k in range(order + 1):
-            cols += [np.cos(heading) * tt ** k, np.sin(heading) * tt ** k]
+        for b in basis:
+            cols += [np.cos(heading) * b, np.sin(heading) * b]
         return np.column_stack(cols)
 
-    # the current's change with time: the richest polynomial (quadratic: a tide's curvature over a
-    # few hours; linear; constant) that leaves at least 3 legs over and is resolved by the legs
-    order = next((k for k in (2, 1) if n - (G + 2 * (k + 1)) >= 3
-                  and np.linalg.matrix_rank(design(k)) == G + 2 * (k + 1)), 0)
-    trend = order >= 1
-    p = G + 2 * (order + 1)
+    def npar(order):
+        return G + 2 * len(_current_basis(t[:1], order, tm, 1.0)[0])
+
+    # the current's change with time: over a long day the steady stream plus the semidiurnal tide, else
+    # the richest polynomial (quadratic: a tide's curvature over a few hours; linear; constant), the
+    # first that leaves at least 3 legs over and is resolved by the legs
+    models = (("tidal",) if np.ptp(t) >= 0.5 * CUR.TIDAL_PERIOD else ()) + (2, 1)
+    order = next((k for k in models if n - npar(k) >= 3 and np.linalg.matrix_rank(design(k)) == npar(k)), 0)
+    trend = order != 0
+    p = npar(order)
     rank = int(np.linalg.matrix_rank(design(order)))
     if n > p and rank == p:
         track = heading if drift is None else heading + np.asarray(drift, dtype=float)
         f = _joint_current_fit(t, track, vg, vg_std, group, order)
+        if ratio is not None:  # the log's relative readings, where they explain the legs better
+            fr = _joint_current_fit(t, track, vg, vg_std, group, order, ratio=ratio)
+            if (fr["tau"], fr["chi2"]) < (f["tau"], f["chi2"]):
+                f = fr
         x, cov, dof, tau = f["x"], f["cov"], f["dof"], f["tau"]
         sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
         # the groups' speeds carry τ in full (normal quantile): τ stands for the ship's leg-to-leg scatter
@@ -831,10 +924,12 @@ def resolve_current(t, heading, vg, vg_std, group, drift=None):
         cur = {"north": Estimate(float(x[G]), float(sd[G])),
                "east": Estimate(float(x[G + 1]), float(sd[G + 1])), "trend": trend, "order": order,
                "t_ref": f["t_ref"]}
-        for k, name in ((1, "rate"), (2, "accel")):
-            if order >= k:
-                cur[f"north_{name}"] = Estimate(float(x[G + 2 * k]), float(sd[G + 2 * k]))
-                cur[f"east_{name}"] = Estimate(float(x[G + 2 * k + 1]), float(sd[G + 2 * k + 1]))
+        terms = ((1, "cos"), (2, "sin")) if order == "tidal" else ((1, "rate"), (2, "accel"))
+        for k, name in terms[:(p - G) // 2 - 1]:
+            cur[f"north_{name}"] = Estimate(float(x[G + 2 * k]), float(sd[G + 2 * k]))
+            cur[f"east_{name}"] = Estimate(float(x[G + 2 * k + 1]), float(sd[G + 2 * k + 1]))
+        if order == "tidal":
+            cur["tidal_period_s"] = CUR.TIDAL_PERIOD
         return groups, U, cur, {"dof": dof, "residuals": f["residuals"], "trend": trend, "order": order,
                                 "ship_scatter": tau}, []
     if rank < p:

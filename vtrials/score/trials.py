@@ -176,6 +176,10 @@ def score_log_calibration(reduced: dict, res, name: str) -> dict:
         dt = leg["t_mid"] - tref
         cn, ce = (cur[c]["value"] + sum(cur[f"{c}_{k}"]["value"] * dt ** p for p, k in ((1, "rate"), (2, "accel"))
                                         if f"{c}_{k}" in cur) for c in ("north", "east"))
+        if "tidal_period_s" in cur:  # steady stream plus semidiurnal tide about t_ref
+            w = 2.0 * math.pi * dt / cur["tidal_period_s"]
+            cn, ce = (x + cur[f"{c}_cos"]["value"] * math.cos(w) + cur[f"{c}_sin"]["value"] * math.sin(w)
+                      for x, c in ((cn, "north"), (ce, "east")))
         cur_err.append({"run": leg["run"], "reduced": [cn, ce], "truth": [tr["current_n"], tr["current_e"]],
                         "error_mps": math.hypot(cn - tr["current_n"], ce - tr["current_e"])})
     cals = {}
