@@ -79,10 +79,12 @@ from vtrials.reduce.estimate import Estimate
 from vtrials.reduce.series import clean_series as _clean, noise_sigma, ar1_inflation as _ar1_inflation, slope_variance, \
     correlated_variance
 
+# a signed speed through the water is astern only with a surge below −0.1 m/s (the references' rule:
+# vtrials.truth.metrics.signed_speed)
+STERNWAY_MPS = 0.1
+
 
 # --------------------------------------------------------------------------------------------- helpers
-
-STERNWAY_MPS = 0.1  # astern only with a surge below −0.1 m/s (the references' rule: truth.metrics.signed_speed)
 
 def _line(t, y):
     """OLS y = a + b (t − t̄) → (a, b, SE(a), SE(b), t̄) with the residual σ."""
