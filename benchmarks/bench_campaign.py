@@ -7,7 +7,8 @@ Two measurements on the same machine, one after the other:
    write truth.nc and the records, reduce, score, results.json and the report with its figures), wall
    time of the whole command;
 2. the campaign — ``run_campaign`` of the campaign scenario on a spawn process pool of ``--workers``
-   processes; every replicate takes the fast path (records reduced in memory, nothing written:
+   processes, ``--batch`` replicates stepped together in one simulator per task; every replicate takes
+   the fast path (records reduced in memory, nothing written:
    :func:`vtrials.runner.trial_day.score_agenda`). Wall time, replicates per hour, and the ratio of the
    campaign's wall time per replicate to the single run's wall time.
 
@@ -71,9 +72,10 @@ def single_run(scenario: str) -> dict:
             "simulated_time_s": res.get("simulated_time_s")}
 
 
-def campaign(scenario: str, out: Path, n: int, workers: int, time_limit: float | None) -> dict:
-    """Run replicates 0..n−1 on a spawn pool; stop handing out new ones after ``time_limit`` s."""
-    from vtrials.campaign.run import _write_json_atomic, default_executor, finish, run_replicate
+def campaign(scenario: str, out: Path, n: int, workers: int, time_limit: float | None, batch: int = 1) -> dict:
+    """Run replicates 0..n−1 on a spawn pool, ``batch`` per simulator; stop handing out new ones after
+    ``time_limit`` s."""
+    from vtrials.campaign.run import _write_json_atomic, default_executor, finish, run_replicates
     from vtrials.campaign.spec import load_campaign
     spec = load_campaign(scenario)
     parts = out / "parts"
@@ -88,16 +90,17 @@ def campaign(scenario: str, out: Path, n: int, workers: int, time_limit: float |
     try:
         while nxt < n or pending:
             while nxt < n and len(pending) < 2 * workers and not stopped:
-                pending.add(ex.submit(run_replicate, scenario, nxt, spec.seed, n, None))
-                nxt += 1
+                group = list(range(nxt, min(nxt + batch, n)))
+                pending.add(ex.submit(run_replicates, scenario, group, spec.seed, n, None))
+                nxt += len(group)
             if not pending:
                 break
             fin, pending = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
             for f in fin:
-                r = f.result()
-                _write_json_atomic(parts / f"replicate_{r['replicate']:05d}.json", r)
-                done.add(r["replicate"])
-                timings.append(r.get("timings") or {})
+                for r in f.result():
+                    _write_json_atomic(parts / f"replicate_{r['replicate']:05d}.json", r)
+                    done.add(r["replicate"])
+                    timings.append(r.get("timings") or {})
             if time_limit is not None and time.perf_counter() - t0 > time_limit and not stopped:
                 stopped = True
                 nxt = n  # no more submissions; the running ones finish
@@ -122,6 +125,7 @@ def main() -> None:
                     help="scenario of the single-run path (the campaign scenario's base)")
     ap.add_argument("--replicates", type=int, default=200)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--batch", type=int, default=1, help="replicates per simulator (run_replicates)")
     ap.add_argument("--time-limit", type=float, default=None, help="seconds of campaign wall time")
     ap.add_argument("--out", help="campaign directory (default: a temporary one)")
     ap.add_argument("--json", default=str(ROOT / "benchmarks" / "results" / "bench_campaign.json"))
@@ -131,10 +135,10 @@ def main() -> None:
     load_start = os.getloadavg()
     single = single_run(a.single)
     out = Path(a.out or tempfile.mkdtemp(prefix="vtrials-bench-campaign-"))
-    camp = campaign(a.scenario, out, a.replicates, a.workers, a.time_limit)
+    camp = campaign(a.scenario, out, a.replicates, a.workers, a.time_limit, a.batch)
     per_rep = camp["wall_s"] / max(camp["replicates_run"], 1)
     doc = {"scenario": a.scenario, "single_run_scenario": a.single, "replicates_requested": a.replicates,
-           "workers": a.workers, "executor": "spawn process pool",
+           "workers": a.workers, "batch": a.batch, "executor": "spawn process pool",
            "machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(), "python": sys.version.split()[0],
                        "load_average_at_start": list(load_start), "load_average_at_end": list(os.getloadavg()),
                        "load_1min_during": load.stop(),

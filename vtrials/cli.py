@@ -108,6 +108,9 @@ def build_parser() -> argparse.ArgumentParser:
                                                         "a local cluster)")
     c.add_argument("--workers", type=int, metavar="K", help="worker processes (process pool; default: CPU count)")
     c.add_argument("--resume", action="store_true", help="continue a campaign killed before it finished")
+    c.add_argument("--batch", type=int, default=1, metavar="B",
+                   help="replicates a worker steps together in one simulator (same table for any B; faster per "
+                        "replicate, B days' records in memory at once; default 1)")
     c.add_argument("--records", action="store_true", help="keep every replicate's records and truth")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
     pl = sub.add_parser("plan", help="the cheapest trial agenda predicted to meet an accuracy target",
@@ -205,7 +208,8 @@ def _identify(args) -> int:
 
 def _campaign(args) -> int:
     from vtrials.campaign.run import run_campaign
-    for name, v, lo in (("--replicates", args.replicates, 1), ("--workers", args.workers, 1), ("--seed", args.seed, 0)):
+    for name, v, lo in (("--replicates", args.replicates, 1), ("--workers", args.workers, 1), ("--seed", args.seed, 0),
+                        ("--batch", args.batch, 1)):
         if v is not None and v < lo:
             raise InputError(name, "", f"must be at least {lo}")
     executor, client = None, None
@@ -219,7 +223,7 @@ def _campaign(args) -> int:
     try:
         doc = run_campaign(args.scenario, args.out, replicates=args.replicates, seed=args.seed, executor=executor,
                            workers=args.workers, resume=args.resume, keep_records=args.records,
-                           progress=not args.quiet)
+                           progress=not args.quiet, batch=args.batch)
     finally:
         if client is not None:
             client.close()

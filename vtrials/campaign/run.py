@@ -36,7 +36,7 @@ import time
 from pathlib import Path
 
 from vtrials.campaign.spec import CampaignSpec, load_campaign, replicate_doc, replicate_seeds
-from vtrials.errors import InputError
+from vtrials.errors import InputError, SimulationError
 
 COLUMNS = ("replicate", "quantity", "group", "reduced", "std", "lo95", "hi95", "half_width95", "truth", "error",
            "covered")
@@ -88,17 +88,18 @@ def rows_of(results: dict, replicate: int) -> list[dict]:
     return rows
 
 
-def run_replicate(path: str, index: int, campaign_seed: int, n_total: int, keep_dir: str | None = None) -> dict:
-    """Run replicate ``index`` of the campaign in ``path`` (in a worker); returns its rows and draws."""
-    from vtrials.runner.trial_day import score_agenda, simulate_agenda, write_agenda_outputs
+def _replicate_scenario(path: str, spec, index: int, campaign_seed: int, n_total: int):
     from vtrials.scenario import load_scenario
-    spec = load_campaign(path)
     ss = replicate_seeds(campaign_seed, n_total)[index]
     doc, drawn = replicate_doc(spec, ss)
     scn = load_scenario(path, doc)
     if scn.agenda is None:
         raise InputError(path, "agenda", "a campaign needs an [agenda] (its reductions are what is scored)")
-    res = simulate_agenda(scn)
+    return scn, drawn
+
+
+def _score_day(res, index: int, drawn: dict, keep_dir: str | None) -> dict:
+    from vtrials.runner.trial_day import score_agenda, write_agenda_outputs
     if keep_dir is None:
         # the fast path: records reduced in memory (the same arrays the files would hold), nothing written
         out = score_agenda(res)
@@ -109,11 +110,42 @@ def run_replicate(path: str, index: int, campaign_seed: int, n_total: int, keep_
             if dest.exists():
                 shutil.rmtree(dest)
             shutil.copytree(tmp, dest)
-    row = {"replicate": index, "drawn": drawn, "rows": rows_of(out, index),
-           "simulated_time_s": out.get("simulated_time_s"), "timings": out.get("timings")}
-    del res, out
+    return {"replicate": index, "drawn": drawn, "rows": rows_of(out, index),
+            "simulated_time_s": out.get("simulated_time_s"), "timings": out.get("timings")}
+
+
+def run_replicate(path: str, index: int, campaign_seed: int, n_total: int, keep_dir: str | None = None) -> dict:
+    """Run replicate ``index`` of the campaign in ``path`` (in a worker); returns its rows and draws."""
+    return run_replicates(path, [index], campaign_seed, n_total, keep_dir)[0]
+
+
+def run_replicates(path: str, indices: list[int], campaign_seed: int, n_total: int,
+                   keep_dir: str | None = None) -> list[dict]:
+    """Run replicates ``indices`` of the campaign in ``path`` (in a worker), stepped together as the
+    ships of one simulator when they can share it (:func:`vtrials.runner.trial_day.simulate_agendas`;
+    each replicate's records are bit-identical to its day run alone, so the table does not depend on
+    the batch size); returns their rows and draws, in the order of ``indices``."""
+    from vtrials.runner.trial_day import CannotShare, simulate_agendas
+    spec = load_campaign(path)
+    days = [_replicate_scenario(path, spec, i, campaign_seed, n_total) for i in indices]
+    scns = [scn for scn, _ in days]
+    try:
+        results = simulate_agendas(scns)
+    except (SimulationError, CannotShare):
+        if len(scns) == 1:
+            raise
+        # days that cannot share a simulator, or one ship's blow-up (it stops the whole batch): run the
+        # days one by one, so the others complete and a failing replicate reports its own error
+        del days, scns
+        release_memory()
+        return [r for i in indices for r in run_replicates(path, [i], campaign_seed, n_total, keep_dir)]
+    rows = []
+    for k, (i, (_, drawn)) in enumerate(zip(indices, days)):
+        rows.append(_score_day(results[k], i, drawn, keep_dir))
+        results[k] = None  # its records and truth can go before the next day is scored
+    del results, days, scns
     release_memory()
-    return row
+    return rows
 
 
 def release_memory() -> None:
@@ -156,12 +188,17 @@ def _write_json_atomic(path: Path, obj) -> None:
 
 def run_campaign(path: str | Path, out_dir: str | Path, replicates: int | None = None, seed: int | None = None,
                  executor: cf.Executor | None = None, workers: int | None = None, resume: bool = False,
-                 keep_records: bool = False, progress: bool = False) -> dict:
+                 keep_records: bool = False, progress: bool = False, batch: int = 1) -> dict:
     """Run (or resume) a campaign; write ``campaign.parquet``, ``summary.parquet`` and ``summary.json``.
 
     Returns the summary document. ``executor``: any concurrent.futures.Executor (default: a spawn
-    process pool of ``workers`` processes, closed at the end).
+    process pool of ``workers`` processes, closed at the end). ``batch``: replicates a worker steps
+    together in one simulator (:func:`run_replicates`; the table is the same for any value, and
+    benchmarks/bench_campaign.py measures what it saves; each replicate of the batch holds its day's
+    records in memory at once).
     """
+    if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
+        raise InputError("run_campaign", "batch", f"expected an integer ≥ 1 (replicates per simulator), got {batch!r}")
     path = str(path)
     spec = load_campaign(path)  # checks the file before anything is started
     n = int(replicates or spec.replicates)
@@ -192,12 +229,13 @@ def run_campaign(path: str | Path, out_dir: str | Path, replicates: int | None =
         bar = tqdm(total=n, initial=n - len(todo), unit="replicate", desc="campaign", dynamic_ncols=True)
     t0 = time.perf_counter()
     try:
-        futs = [ex.submit(run_replicate, path, i, cseed, n, keep) for i in todo]
+        groups = [todo[k:k + batch] for k in range(0, len(todo), batch)]
+        futs = [ex.submit(run_replicates, path, g, cseed, n, keep) for g in groups]
         for fut in cf.as_completed(futs):
-            r = fut.result()
-            _write_json_atomic(parts / f"replicate_{r['replicate']:05d}.json", r)
-            if bar is not None:
-                bar.update(1)
+            for r in fut.result():
+                _write_json_atomic(parts / f"replicate_{r['replicate']:05d}.json", r)
+                if bar is not None:
+                    bar.update(1)
     finally:
         if bar is not None:
             bar.close()
@@ -232,7 +270,8 @@ def finish(out_dir: str | Path, n: int, wall_s: float | None = None) -> dict:
     summary = []
     for g in sorted(groups):
         rs = groups[g]
-        v = verdict([r["covered"] for r in rs], [r["half_width95"] for r in rs], [r["error"] for r in rs])
+        v = verdict([r["covered"] for r in rs], [r["half_width95"] for r in rs], [r["error"] for r in rs],
+                    clusters=[r["replicate"] for r in rs])
         summary.append({"group": g, **v})
     scols = list(summary[0]) if summary else ["group"]
     pq.write_table(pa.table({c: [s[c] for s in summary] for c in scols}), out / "summary.parquet")

@@ -487,7 +487,7 @@ class Simulator:
                 first = (-self._step_count) % every  # the run's first recorded step
                 if first < left:
                     if self._chunk is None or self._krow >= self._chunk.shape[0]:
-                        self._new_chunk()
+                        self._new_chunk((left - first - 1) // every + 1)
                     rec = self._chunk
                     m = min(left, first + (rec.shape[0] - self._krow) * every)
             if self._shards and m * self.n >= SHARD_FROM:
@@ -599,10 +599,12 @@ class Simulator:
                f"accelerations {np.array2string(self.nudot[i], precision=4)}")
         raise SimulationError(msg, time_s=float(self.time[i]), ship=i)
 
-    def _new_chunk(self):
+    def _new_chunk(self, rows: int = 4096):
+        """A new truth chunk for ``rows`` more rows (at most 4096): sized to the run ahead, so that
+        short runs (a fleet's crews act every second or so) do not allocate and fill 4096 rows each."""
         if self._chunk is not None:
             self._chunks.append(self._chunk[: self._krow])
-        self._chunk = np.zeros((4096, self.n, self.rec_width))
+        self._chunk = np.zeros((max(1, min(int(rows), 4096)), self.n, self.rec_width))
         self._krow = 0
 
     def truth(self) -> np.ndarray:

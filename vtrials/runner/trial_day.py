@@ -52,15 +52,9 @@ class AgendaResult:
         return self.crew.attempts
 
 
-def _initial_state(sim: Simulator, scn: Scenario, calm: Simulator | None = None) -> ShipState:
-    """Steady at the first run's setting on its course, or the scenario's [initial] if it has one.
-
-    ``calm``: a simulator of the calm-water ship in which to find that condition when ``sim`` carries
-    a seaway (the steady search would otherwise balance one instant's wave excitation); the ship
-    then starts in the sea from the calm-water steady condition and settles within the approach."""
-    place = sim
-    if calm is not None:
-        sim = calm
+def _initial_state(sim: Simulator, scn: Scenario) -> ShipState:
+    """Steady at the first run's setting on its course, or the scenario's [initial] if it has one,
+    found on ship 0 of ``sim`` (a one-ship simulator of the calm-water ship for the search)."""
     v = scn.vessel
     first = scn.agenda.runs[0]
     f = str(scn.path)
@@ -87,46 +81,121 @@ def _initial_state(sim: Simulator, scn: Scenario, calm: Simulator | None = None)
         back = abs(s.u) * (2.0 * rules.runout_s + rules.approach_s + 0.5 * first.duration)
         c = scn.site.get("range_center", [0.0, 0.0])
         s = dataclasses.replace(s, x=c[0] - back * math.cos(heading), y=c[1] - back * math.sin(heading))
-    place.set_state(0, s)
     return s
 
 
 def simulate_agenda(scn: Scenario, progress=None) -> AgendaResult:
-    t_wall = time.perf_counter()
-    timings = {}
-    vessel = scn.vessel
-    # in a seaway the ship carries the wave components (vtrials.scenario.sea_vessel); the calm-water
-    # references below (tank prediction, calm-water speed-power, steady turns) keep scn.vessel
+    """One trial day: the crew executes the agenda on the scenario's ship (see the module docstring)."""
+    return simulate_agendas([scn], progress=progress)[0]
+
+
+def _same_ship(a, b) -> bool:
+    """Whether vessels ``a`` and ``b`` can be ships of one :class:`Simulator` — the same model, masses,
+    steering, machinery and autopilot, and force components of the same kinds and sizes (their
+    parameter values may differ: each ship gets its own, e.g. its own wave realization)."""
+    if a is b:
+        return True
+    if (a.name, str(a.mjcf_path)) != (b.name, str(b.mjcf_path)) or a.added_mass.coriolis != b.added_mass.coriolis \
+            or a.autopilot != b.autopilot or a.mass != b.mass:
+        return False
+    if not all(np.array_equal(x, y) for x, y in ((a.r_G, b.r_G), (a.M_RB, b.M_RB), (a.M_A, b.M_A),
+                                                  (a.steering, b.steering), (a.shaft_params, b.shaft_params))):
+        return False
+    ca, cb = a.components, b.components
+    return len(ca) == len(cb) and all(p.name == q.name and p.type == q.type and p.params.shape == q.params.shape
+                                      and np.array_equal(p.states, q.states) for p, q in zip(ca, cb))
+
+
+def _day_setup(scn: Scenario):
+    """The ship (with its seaway's components), its environment block and its starting condition."""
     ship, _dropped = sea_vessel(scn)
     env = environment_block(scn)
-    sim = Simulator(ship, 1, scn.head.timestep_s, env, record_every=scn.head.record_every)
-    calm = None if ship is vessel else Simulator(vessel, 1, scn.head.timestep_s, env, record_every=0)
-    _initial_state(sim, scn, calm)
-    timings["sea_setup_s"] = time.perf_counter() - t_wall
-    iset = instrument_set(scn)
-    sea = observe_sea(scn.waves, scn.head.seed)
-    if sea:  # the wave buoy's (or hindcast's) sea state, for the analysis's wave correction
-        iset.team["sea_observed"] = sea
-    iset.reset()
-    crew = Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every, progress=progress)
+    dt = scn.head.timestep_s
+    # the steady search runs in a simulator of its own: in a seaway on the calm-water ship (it would
+    # otherwise balance one instant's wave excitation; the ship then starts in the sea from the
+    # calm-water steady condition and settles within the approach)
+    search = Simulator(scn.vessel if ship is not scn.vessel else ship, 1, dt, env, record_every=0)
+    return ship, env, _initial_state(search, scn)
+
+
+class CannotShare(ValueError):
+    """Trial days that cannot be ships of one simulator (:func:`can_share_simulator`)."""
+
+
+def can_share_simulator(scns: list[Scenario], setups: list | None = None) -> bool:
+    """Whether the days of ``scns`` can be stepped together in one simulator (:func:`simulate_agendas`):
+    the same time step and truth rate, environment blocks of one size and ships that :func:`_same_ship`."""
+    setups = setups or [_day_setup(s) for s in scns]
+    s0, (v0, e0, _) = scns[0], setups[0]
+    return all(s.head.timestep_s == s0.head.timestep_s and s.head.record_every == s0.head.record_every
+               and e.shape == e0.shape and _same_ship(v0, v) for s, (v, e, _) in zip(scns, setups))
+
+
+def simulate_agendas(scns: list[Scenario], progress=None) -> list[AgendaResult]:
+    """The trial days of ``scns``, stepped together as the ships of one simulator, each with its own
+    crew, instruments, environment and seaway (:mod:`vtrials.trials.fleet`); a campaign's way to
+    amortize the per-step cost (issue 11). Each day's records are bit-identical to its day simulated
+    alone. ``progress`` is given to the first day's crew. Raises :class:`CannotShare` when the days cannot share
+    a simulator (:func:`can_share_simulator`)."""
+    t_wall = time.perf_counter()
+    setups, t_setup = [], []
+    for scn in scns:
+        t0 = time.perf_counter()
+        setups.append(_day_setup(scn))
+        t_setup.append(time.perf_counter() - t0)
+    if not can_share_simulator(scns, setups):
+        raise CannotShare("these trial days cannot share one simulator (time step, truth rate, environment "
+                         "block size or ship differ); simulate them one by one")
+    n = len(scns)
+    s0 = scns[0]
+    ship0 = setups[0][0]
+    sim = Simulator(ship0, n, s0.head.timestep_s, np.stack([e for _, e, _ in setups]),
+                    record_every=s0.head.record_every)
+    fleet = None
+    if n > 1:
+        from vtrials.trials.fleet import Fleet
+        fleet = Fleet(sim)
+    crews = []
+    for i, (scn, (ship, _env, start)) in enumerate(zip(scns, setups)):
+        for c0, c in zip(ship0.components, ship.components):
+            if c.params is not c0.params and not np.array_equal(c.params, c0.params):
+                sim.set_component_params(i, c.name, c.params)
+        sim.set_state(i, start, alone=True)
+        iset = instrument_set(scn)
+        sea = observe_sea(scn.waves, scn.head.seed)
+        if sea:  # the wave buoy's (or hindcast's) sea state, for the analysis's wave correction
+            iset.team["sea_observed"] = sea
+        iset.reset()
+        crews.append(Crew(sim, scn.agenda, iset, truth_every=scn.head.truth_every,
+                          progress=progress if i == 0 else None, ship=i,
+                          driver=None if fleet is None else fleet.driver(i)))
+    t_sim = time.perf_counter()
     try:
-        crew.run_agenda()
+        if fleet is None:
+            crews[0].run_agenda()
+        else:
+            fleet.run([(i, c.run_agenda) for i, c in enumerate(crews)])
+    except KeyboardInterrupt as exc:  # the CLI names the trial time it stopped at
+        exc.trial_time_s = float(crews[0].t)
+        raise
+    sim_s = (time.perf_counter() - t_sim) / n  # a shared simulator's time, shared evenly
+    out = []
+    for scn, crew, ts in zip(scns, crews, t_setup):
+        timings = {"sea_setup_s": ts}
         t_ins = time.perf_counter()
-        iset.flush()
+        crew.iset.flush()
         crew.instrument_wall_s += time.perf_counter() - t_ins
-        timings["simulate_s"] = time.perf_counter() - t_wall
+        timings["simulate_s"] = sim_s + time.perf_counter() - t_ins
         timings["instruments_s"] = crew.instrument_wall_s
         t1 = time.perf_counter()
         calm = calm_water_truth(scn, crew)
         calm.update(spiral_truth(scn, crew))
-    except KeyboardInterrupt as exc:  # the CLI names the trial time it stopped at
-        exc.trial_time_s = float(crew.t)
-        raise
-    timings["calm_water_s"] = time.perf_counter() - t1
-    field = wave_field(scn)
-    return AgendaResult(scn, crew, crew.t, time.perf_counter() - t_wall, calm, timings,
-                        seaway=None if field is None else field.components,
-                        hydro_path=hydro_path(vessel) if field is not None else None)
+        timings["calm_water_s"] = time.perf_counter() - t1
+        field = wave_field(scn)
+        out.append(AgendaResult(scn, crew, crew.t, ts + sim_s + time.perf_counter() - t_ins, calm, timings,
+                                seaway=None if field is None else field.components,
+                                hydro_path=hydro_path(scn.vessel) if field is not None else None))
+    return out
 
 
 def _accepted(crew: Crew, trial: str) -> list:

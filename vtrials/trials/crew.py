@@ -219,15 +219,21 @@ def window_truth(cols: dict, t0: float, t1: float) -> dict:
 
 # ----------------------------------------------------------------------------------- the crew
 class Crew:
-    """Runs an :class:`~vtrials.trials.agenda.Agenda` on ship 0 of a one-ship :class:`Simulator`.
+    """Runs an :class:`~vtrials.trials.agenda.Agenda` on ship ``ship`` of a :class:`Simulator`.
 
     ``iset``: the ship's :class:`~vtrials.instruments.suite.InstrumentSet` (reset by the caller);
     ``truth_every``: keep every k-th truth row for the truth file (instruments see every row);
-    ``progress``: a callable taking one line of text (None: silent).
+    ``progress``: a callable taking one line of text (None: silent);
+    ``driver``: who steps the simulator — a :class:`~vtrials.trials.driver.Driver` of this crew alone
+    (default), or a fleet's :class:`~vtrials.trials.fleet.ShipDriver` when many crews share one
+    simulator, each its own ship.
     """
 
-    def __init__(self, sim: Simulator, agenda: Agenda, iset, truth_every: int = 1, progress=None):
+    def __init__(self, sim: Simulator, agenda: Agenda, iset, truth_every: int = 1, progress=None,
+                 ship: int = 0, driver: Driver | None = None):
         self.sim = sim
+        self.ship = int(ship)
+        self._t_done: float | None = None
         self.agenda = agenda
         self.rules = agenda.rules
         self.st = agenda.steadiness
@@ -249,7 +255,11 @@ class Crew:
         self._row_count = 0
         self._keep_from = math.inf  # truth rows after this time are kept for the running attempt
         # the crew drives the ship through the driver, which streams the truth into the instruments
-        self.driver = Driver(sim, {0: iset}, sinks=[self._keep])
+        if driver is None:
+            driver = Driver(sim)
+        driver.instruments[self.ship] = iset
+        driver.sinks.append(self._keep)
+        self.driver = driver
         self._t_change = 0.0
         self._final_phase = 0
         self._course = 0.0
@@ -284,7 +294,9 @@ class Crew:
     # ------------------------------------------------------------------ time
     @property
     def t(self) -> float:
-        return float(self.sim.time[0])
+        if self._t_done is not None:  # the day is over (in a fleet the ship may go on being stepped)
+            return self._t_done
+        return float(self.sim.time[self.ship])
 
     def advance(self, seconds: float) -> None:
         """Simulate ``seconds`` more; the driver streams the truth into the instruments as it goes."""
@@ -387,14 +399,14 @@ class Crew:
 
     def _order_shaft(self, k: int, rps: float, pitch: float, mode: str) -> None:
         sim = self.sim
-        sim.set_shaft_order(0, rps, k)
-        sim.set_pitch_order(0, pitch, k)
-        sim.set_shaft_mode(0, mode, k)
+        sim.set_shaft_order(self.ship, rps, k)
+        sim.set_pitch_order(self.ship, pitch, k)
+        sim.set_shaft_mode(self.ship, mode, k)
         self.rps_order[k], self.pitch_order[k], self.modes[k] = rps, pitch, mode
         self.settings.append((self.t, k, rps, pitch, MODE_NAMES[mode]))
 
     def _helm(self, phases: list) -> None:
-        self.sim.set_helm(0, phases)
+        self.sim.set_helm(self.ship, phases)
         self._final_phase = len(phases) - 1
 
     def hold(self, course: float, limit: float) -> None:
@@ -405,7 +417,7 @@ class Crew:
         """Turn onto ``course``: a Williamson turn for a reversal, else a turn with the turning rudder,
         easing ``TURN_LEAD_DEG`` before the new course; the helm then meets the swing with the turning
         rudder available before settling to the run's limit."""
-        psi = float(self.sim.nav[0, NV_PSI_U])
+        psi = float(self.sim.nav[self.ship, NV_PSI_U])
         d = math.atan2(math.sin(course - psi), math.cos(course - psi))
         dt = self.rules.turn_rudder_deg * DEG
         lead = TURN_LEAD_DEG * DEG
@@ -429,9 +441,9 @@ class Crew:
 
     def _helm_settled_since(self) -> float | None:
         """Time the helm entered its final (course-holding) phase, None if still turning."""
-        if self.sim.helm_phase(0) < self._final_phase:
+        if self.sim.helm_phase(self.ship) < self._final_phase:
             return None
-        ts = float(self.sim.hs[0, H.H_TSTART])
+        ts = float(self.sim.hs[self.ship, H.H_TSTART])
         return ts if ts >= 0 else self.t
 
     # ------------------------------------------------------------------ where the ship is
@@ -551,7 +563,7 @@ class Crew:
         att = Attempt(run, attempt, math.degrees(run.heading) % 360.0, [], [], list(run.modes), self.t)
         if attempt == 1:
             self.set_shafts(run)
-        psi = float(self.sim.nav[0, NV_PSI_U])
+        psi = float(self.sim.nav[self.ship, NV_PSI_U])
         change = abs(math.atan2(math.sin(run.heading - psi), math.cos(run.heading - psi)))
         placed = self.rules.measured_course and self._track is not None and attempt == 1 and \
             (change > 150 * DEG or self._runs_done == 0)
@@ -720,6 +732,7 @@ class Crew:
                 self.say(f"      repeating run {run.number} (attempt {attempt})")
         self.say(f"agenda complete: {len(self.attempts)} runs executed in {(self.t - total0) / 3600:.2f} h of "
                  f"trial time")
+        self._t_done = self.t
 
     def _setting_text(self) -> str:
         parts = []

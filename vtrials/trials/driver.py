@@ -91,11 +91,22 @@ class Driver:
         while n > 0:
             k = min(n, self.slice_steps)
             try:
-                self.sim.step(k)
+                self._step(k)
                 self.step_count += k
             finally:
                 self._hand_over()
             n -= k
+
+    def _step(self, k: int) -> None:
+        self.sim.step(k)
+
+    def _take_truth(self) -> dict:
+        """The truth rows since the last hand-over, {ship: rows (K, width)}, taken out of the simulator."""
+        rec = self.sim.truth()
+        self.sim.clear_truth()
+        if rec.shape[0] == 0:
+            return {}
+        return {ship: np.ascontiguousarray(rec[:, ship, :]) for ship in range(rec.shape[1])}
 
     def advance(self, seconds: float) -> None:
         """Simulate ``seconds`` more (rounded to whole steps)."""
@@ -103,16 +114,14 @@ class Driver:
 
     def _hand_over(self) -> None:
         import time
-        rec = self.sim.truth()
-        self.sim.clear_truth()
-        if rec.shape[0] == 0:
+        taken = self._take_truth()
+        if not taken:
             return
         flush = False
         if self.instruments:
-            self._unflushed += rec.shape[0]
+            self._unflushed += next(iter(taken.values())).shape[0]
             flush = self._unflushed * self.sim.dt * self.sim.record_every >= self.flush_every_s - 1e-9
-        for ship in range(rec.shape[1]):
-            rows = np.ascontiguousarray(rec[:, ship, :])
+        for ship, rows in taken.items():
             iset = self.instruments.get(ship)
             if iset is not None:
                 iset.push(self.columns(rows))

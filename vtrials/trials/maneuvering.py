@@ -104,7 +104,7 @@ def execute(crew, run: Run, att) -> None:
     p = run.params
     kind = p["type"]
     t_exec = crew.t
-    psi0 = float(crew.sim.nav[0, NV_PSI_U])
+    psi0 = float(crew.sim.nav[crew.ship, NV_PSI_U])
     gains = crew.gains
     dmax = crew.vessel.max_rudder
     limit = p.get("max_duration_s") or {"turn": 3600.0, "speed_change": 1800.0, "zigzag": 1800.0,
@@ -129,7 +129,7 @@ def execute(crew, run: Run, att) -> None:
                     (H.HOLD, 0.0, 0.0)])
         while crew.t - t_exec < limit:
             crew.advance(LOOK_S)
-            if crew.sim.helm_phase(0) >= 1:
+            if crew.sim.helm_phase(crew.ship) >= 1:
                 done = True
                 break
     elif kind == "speed_change":
