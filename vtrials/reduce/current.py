@@ -180,12 +180,23 @@ class SpotCurrentFit:
     residuals: np.ndarray
     cov_stated: np.ndarray
     ship_scatter: float = 0.0
+    cov_shape: np.ndarray | None = None  # covariance of ``shape`` with the runs weighed by σᵢ² + τ²
 
     def current_change(self, t) -> np.ndarray:
         """The fitted time-varying part of the along-course current at times t [s] (m/s; its constant
         is in the spots' offsets)."""
         return _shape_basis(np.atleast_1d(np.asarray(t, float)), self.model, self.t_ref, self.t_span,
                             self.period) @ self.shape
+
+    def current_rate(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Rate of change of the fitted along-course current at times t [s] and its standard
+        uncertainty (m/s², along the base course): dc/dt of the shape terms, 1/T_span for the
+        linear term, ∓ω sin/cos ωτ for the tidal pair."""
+        d = _shape_rate_basis(np.atleast_1d(np.asarray(t, float)), self.model, self.t_ref, self.t_span,
+                              self.period)
+        rate = d @ self.shape
+        cov = self.cov_shape if self.cov_shape is not None else np.zeros((d.shape[1], d.shape[1]))
+        return rate, np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", d, cov, d), 0.0))
 
 
 _SHAPES = {"tidal": 3, "linear": 1, "none": 0}
@@ -198,6 +209,18 @@ def _shape_basis(t, model, t_ref, t_span, period):
         cols.append(tau / t_span)
     if model == "tidal":
         cols += [np.cos(TWO_PI * tau / period), np.sin(TWO_PI * tau / period)]
+    return np.column_stack(cols) if cols else np.zeros((tau.size, 0))
+
+
+def _shape_rate_basis(t, model, t_ref, t_span, period):
+    """Time derivatives of the :func:`_shape_basis` columns [1/s]."""
+    tau = np.asarray(t, float) - t_ref
+    w = TWO_PI / period
+    cols = []
+    if model in ("tidal", "linear"):
+        cols.append(np.full(tau.size, 1.0 / t_span))
+    if model == "tidal":
+        cols += [-w * np.sin(w * tau), w * np.cos(w * tau)]
     return np.column_stack(cols) if cols else np.zeros((tau.size, 0))
 
 
@@ -326,9 +349,11 @@ def joint_spot_current_fit(t, vg, vg_std, heading, group, model=None, period=TID
             off = [float(beta[G])] * G
         else:
             off[k] = float(beta[G + j])
+    ks = slice(G + len(both), p)
+    cov_shape = (A[ks] * (vg_std ** 2 + tau ** 2)[None, :]) @ A[ks].T
     return SpotCurrentFit(groups=groups, vs=vs, offset=tuple(off), model=chosen, shape=beta[G + len(both):],
                           t_ref=t_ref, t_span=t_span, period=float(period), chi2=chi2, dof=dof, scale=scale,
-                          residuals=r, cov_stated=cov, ship_scatter=float(tau))
+                          residuals=r, cov_stated=cov, ship_scatter=float(tau), cov_shape=cov_shape)
 
 
 @dataclasses.dataclass(frozen=True)
