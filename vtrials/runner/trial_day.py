@@ -119,13 +119,12 @@ def _day_setup(scn: Scenario):
 
 
 class CannotShare(ValueError):
-    """Trial days that cannot be ships of one simulator (:func:`can_share_simulator`)."""
+    """Trial days that cannot be ships of one simulator (:func:`_can_share`)."""
 
 
-def can_share_simulator(scns: list[Scenario], setups: list | None = None) -> bool:
+def _can_share(scns: list[Scenario], setups: list) -> bool:
     """Whether the days of ``scns`` can be stepped together in one simulator (:func:`simulate_agendas`):
     the same time step and truth rate, environment blocks of one size and ships that :func:`_same_ship`."""
-    setups = setups or [_day_setup(s) for s in scns]
     s0, (v0, e0, _) = scns[0], setups[0]
     return all(s.head.timestep_s == s0.head.timestep_s and s.head.record_every == s0.head.record_every
                and e.shape == e0.shape and _same_ship(v0, v) for s, (v, e, _) in zip(scns, setups))
@@ -136,14 +135,14 @@ def simulate_agendas(scns: list[Scenario], progress=None) -> list[AgendaResult]:
     crew, instruments, environment and seaway (:mod:`vtrials.trials.fleet`); a campaign's way to
     amortize the per-step cost (issue 11). Each day's records are bit-identical to its day simulated
     alone. ``progress`` is given to the first day's crew. Raises :class:`CannotShare` when the days cannot share
-    a simulator (:func:`can_share_simulator`)."""
+    a simulator (:func:`_can_share`)."""
     t_wall = time.perf_counter()
     setups, t_setup = [], []
     for scn in scns:
         t0 = time.perf_counter()
         setups.append(_day_setup(scn))
         t_setup.append(time.perf_counter() - t0)
-    if not can_share_simulator(scns, setups):
+    if not _can_share(scns, setups):
         raise CannotShare("these trial days cannot share one simulator (time step, truth rate, environment "
                          "block size or ship differ); simulate them one by one")
     n = len(scns)
