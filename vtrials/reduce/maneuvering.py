@@ -326,11 +326,13 @@ class LeewayDrift:
                 Estimate(ce.value + float(self.leeway[1]), math.sqrt(cov[1, 1])))
 
 
-def water_track_current(ch: Channels, runs: list[dict], min_window_s: float = 20.0) -> CU.WaterTrackCurrent | None:
+def water_track_current(ch: Channels, runs: list[dict], min_window_s: float = 20.0,
+                        min_windows: int = 2) -> CU.WaterTrackCurrent | None:
     """The day's current from the runs' straight approaches (COMEX to EXECUTE): the tracking's ground
     velocity less the water-track log's velocity turned by the gyro heading
     (:func:`vtrials.reduce.current.current_from_water_track`). None without a water-track log or with
-    fewer than two usable approaches. Unlike the drift of the turning circles it holds no leeway: it is
+    fewer than ``min_windows`` usable approaches (two for the day's current: one approach alone leaves the
+    log's scale and alignment errors whole in it, which its covariance then says). Unlike the drift of the turning circles it holds no leeway: it is
     the current alone, which a straight run's track through the water is corrected for.
 
     Ground velocity per window: the fixes' least-squares slope, its variance from the residuals plus
@@ -356,7 +358,7 @@ def water_track_current(ch: Channels, runs: list[dict], min_window_s: float = 20
         nw = np.count_nonzero(mw)
         rows.append((0.5 * (t0 + t1), (vn.value, ve.value), np.diag([vn.std ** 2 + slow, ve.std ** 2 + slow]), psi,
                      ch.water[mw].mean(axis=0), np.full(2, noise ** 2 / nw)))
-    if len(rows) < 2:
+    if len(rows) < max(min_windows, 1):
         return None
     t, vg, Sg, psi, w, vw = (np.array([row[k] for row in rows]) for k in range(6))
     return CU.current_from_water_track(t, vg, Sg, psi, w, vw, scale_sd=scale_sd, misalignment_sd=mis_sd,
@@ -608,6 +610,14 @@ def reduce_maneuvering(rec: Record) -> dict:
                     dn, de = model(tm)
                     drift = RE.InterpolatedDrift(dn, de, False, model.tau)
                     d["drift_method"] = "day's drift line through all circles (both sides)"
+                elif (single := water_track_current(ch, [r], min_windows=1)) is not None:
+                    # no circles and no other approach (a crash stop on its own): the current from this
+                    # run's own approach, which carries the log's scale and alignment errors and the
+                    # gyro's bias whole (0.04-0.07 m/s at KVLCC2's full speed) — its covariance says so,
+                    # where no correction at all would leave the current out of every interval
+                    cn, ce, cov = single(tm)
+                    drift = RE.InterpolatedDrift(cn, ce, False, (0.0, 0.0), cov)
+                    d["drift_method"] = "current from the water-track log against the tracking (this run's approach)"
                 res = RE.reach_analysis(w["t"], w["north"], w["east"], r["t_execute"], heading=w["heading"],
                                         t_heading=w["t_heading"], drift=drift, approach_s=approach,
                                         seed=int(r["run"]), fix_errors=ch.fix_errors,
