@@ -172,15 +172,19 @@ def _stop_records(rng, current_error=(0.3, 0.2)):
 
 
 def test_dead_in_water_and_terminal_speed_on_the_log_when_the_current_is_poor():
-    """With the current off by 0.36 m/s, the ground track's surge through the water crosses zero ~36 s
-    late (against an interval of a few seconds); on the water-track log the crossing and the terminal
-    sternway are right within their intervals, whatever the current."""
+    """With the current off by 0.36 m/s, the ground track's surge through the water crosses zero ~40 s
+    off; its interval either misses or says the crossing is lost (the receiver's 1-Hz velocity over
+    ±3.5 s leaves the slope of a 0.01 m/s² deceleration undetermined: SE ~50 s); on the water-track log
+    the crossing and the terminal sternway are right within intervals of a few seconds, whatever the
+    current."""
     rng = np.random.default_rng(11)
     t, N, E, hd, vel, water, given, t_diw = _stop_records(rng)
     kw = dict(heading=hd, drift=given, approach_s=120.0, n_boot=40, velocity=vel)
     ground = RE.reach_analysis(t, N, E, 0.0, **kw)
     log = RE.reach_analysis(t, N, E, 0.0, water=water, **kw)
-    assert not ground.time_to_dead_in_water.covers(t_diw)
+    g_tdw = ground.time_to_dead_in_water
+    assert abs(g_tdw.value - t_diw) > 20.0
+    assert not g_tdw.covers(t_diw) or g_tdw.std > 10.0 * log.time_to_dead_in_water.std
     assert log.time_to_dead_in_water.covers(t_diw)
     assert abs(log.time_to_dead_in_water.value - t_diw) < 3.0
     assert log.terminal_speed.covers(-2.0)
