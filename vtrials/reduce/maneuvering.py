@@ -331,9 +331,10 @@ def water_track_current(ch: Channels, runs: list[dict], min_window_s: float = 20
     """The day's current from the runs' straight approaches (COMEX to EXECUTE): the tracking's ground
     velocity less the water-track log's velocity turned by the gyro heading
     (:func:`vtrials.reduce.current.current_from_water_track`). None without a water-track log or with
-    fewer than ``min_windows`` usable approaches (two for the day's current: one approach alone leaves the
-    log's scale and alignment errors whole in it, which its covariance then says). Unlike the drift of the turning circles it holds no leeway: it is
-    the current alone, which a straight run's track through the water is corrected for.
+    fewer than ``min_windows`` usable approaches (two for the day's current: one approach alone leaves
+    the log's scale and alignment errors whole in it, which its covariance then says). Unlike the drift
+    of the turning circles it holds no leeway: it is the current alone, which a straight run's track
+    through the water is corrected for.
 
     Ground velocity per window: the fixes' least-squares slope, its variance from the residuals plus
     the effect of the receiver's time-correlated errors (:func:`vtrials.reduce.series.slope_variance`).
