@@ -845,20 +845,21 @@ def reduce_log_calibration(rec: Record) -> dict:
         # 1.26. A knotmeter's reading noise is its counts' (white, well measured within a leg): there
         # Welch–Satterthwaite with the τ part on the fit's dof (on t its intercept over-covered, 98.5 %
         # [0.957, 0.995] over 200 patrol days)
-        if name in em:
+        slow_wander = name in em
+        if slow_wander:
             nu = [jf["dof"], jf["dof"]]
         else:
             nu = [CUR.scatter_budget(jf["A"][k], vs_cal, jf["tau"], np.zeros(vs.size), jf["dof"])[1] for k in (0, 1)]
         se = np.sqrt(np.maximum(C[0, 0] + 2.0 * xs * C[0, 1] + xs ** 2 * C[1, 1], 0.0))
-        q_t = float(stats.t.ppf(0.975, jf["dof"])) if name in em else 1.96
+        q_t = float(stats.t.ppf(0.975, jf["dof"])) if slow_wander else 1.96
         line = b[0] + b[1] * xs
         fitted = b[0] + b[1] * xr
         ss_res = float(np.sum((yr - fitted) ** 2))
         ss_tot = float(np.sum((yr - yr.mean()) ** 2))
         calibrations[name] = {
             "method": "line solved inside the joint current fit, one speed through water per leg from its "
-                      "reading (legs weighed by their tracking σ and the scatter τ beyond it; Student's t on the "
-                      "fit's dof)",
+                      "reading (legs weighed by their tracking σ and the scatter τ beyond it; "
+                      + ("Student's t on the fit's dof)" if slow_wander else "Welch–Satterthwaite dof)"),
             "intercept": _est(Estimate(float(b[0]), float(sd[0]), nu[0])),
             "slope": _est(Estimate(float(b[1]), float(sd[1]), nu[1])),
             "correlation": float(C[0, 1] / (sd[0] * sd[1])),
