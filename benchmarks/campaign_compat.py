@@ -91,13 +91,11 @@ def replicate(args: tuple) -> dict:
         rec = open_record(paths["ship_motion"])
         tg = read_groups(d / "truth.nc")["groups"]["agenda"]
         g = tg["variables"]
-        cols = truth_columns(g, g["time"])
+        cols = truth_columns(g, g["time"], scn.head.timestep_s)
         clock = imu_clock(tg["attrs"])
 
-        lag = 0.5 * scn.head.timestep_s  # the truth's rates lag its attitude by half a step (score/compat.py)
-
         def score_compat(red, rec, cols, over_ground=False):
-            return _score(red, rec, cols, over_ground=over_ground, clock=clock, rate_lag_s=lag)
+            return _score(red, rec, cols, over_ground=over_ground, clock=clock)
         t_sim = time.perf_counter() - t_start
         if case == "nominal":
             t0, t1 = run_window(rec, length_s=NOMINAL)

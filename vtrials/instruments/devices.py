@@ -1024,11 +1024,11 @@ class SonicAnemometer(Device):
         mean-motion filter."""
         t = cols["t"]
         n = t.size
-        R = SiteKinematics(cols, self.site).R
+        kin = SiteKinematics(cols, self.site)
+        R = kin.R
         names = self.position_at(t)
         r = np.array([self.position_sites[x] for x in names]).reshape(n, 3)
-        nu = np.column_stack([cols["u"], cols["v"], cols["w"]])
-        om = np.column_stack([cols["p"], cols["q"], cols["r"]])
+        nu, om = kin.nu, kin.omega
         v_ned = np.einsum("nij,nj->ni", R, nu)
         slow, self._state = _mean_motion_filter(t, v_ned, self._state)
         h = -(cols["z"] + np.einsum("nj,nj->n", R[:, 2, :], r))

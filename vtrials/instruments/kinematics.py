@@ -8,6 +8,17 @@ axes x forward, y starboard, z down; world north-east-down):
   specific force:       f_S = a_S − Rᵀ g,  g = (0, 0, g) in NED    (what an accelerometer reads)
 These are the same relations MuJoCo's site sensors use; computing them from the recorded truth lets
 instruments run on their own clocks after (or alongside) the simulation.
+
+One instant per row. A truth row is MuJoCo's state between steps of its semi-implicit Euler integrator:
+x_{n+1} = x_n + h v_{n+1}, so the pose and the accelerations belong to the row's time t_n and the
+velocities to the step just taken, t_n − h/2 (the position chords confirm it to 1e-9 m/s,
+tests/test_instruments_kinematics.py). A sensor reads all of them at t_n: with the step h (truth
+column ``step_s``, which the drivers write) the velocities are carried half a step forward with the
+row's own accelerations, ν(t_n) = ν + (h/2)(ν̇ + ω × ν) (the world-frame velocity's midpoint, in body
+axes) and ω(t_n) = ω + (h/2) ω̇. Left uncorrected, the half step put the rate gyros 10 ms late
+against the heading and the fixes and the accelerometers' centripetal term likewise (at dt 0.02 s),
+which biased patrol51's identified Y_ur by +3.6 % (issue 16). Columns without ``step_s`` (an analytic
+or continuous solution) are taken as they are.
 """
 
 from __future__ import annotations
@@ -40,13 +51,33 @@ def _stack(cols: dict, names) -> np.ndarray:
 
 
 class SiteKinematics:
-    """Measurands at a hull site for a chunk of truth columns (dict of equal-length arrays)."""
+    """Measurands at a hull site for a chunk of truth columns (dict of equal-length arrays), all at
+    the rows' instants (velocities carried half an integrator step forward, see the module text)."""
 
     def __init__(self, cols: dict, site: np.ndarray):
         self.c = cols
         self.r = np.asarray(site, dtype=float)
         self.t = cols["t"]
         self._R = None
+        self._cache = {}
+
+    def _half_step(self):
+        """(n, 1) half the integrator step of each row [s], or None (columns already at one instant)."""
+        h = self.c.get("step_s")
+        return None if h is None else 0.5 * np.asarray(h, float).reshape(-1, 1)
+
+    def _centred(self, names):
+        if names not in self._cache:
+            v = _stack(self.c, names)
+            h = self._half_step()
+            if h is not None:
+                om = _stack(self.c, ("p", "q", "r"))
+                nu = _stack(self.c, ("u", "v", "w"))
+                # the world-frame velocity's change over half a step, in body axes; a current steady
+                # over the step changes the velocity through the water by the same
+                v = v + h * (_stack(self.c, ("du", "dv", "dw")) + np.cross(om, nu))
+            self._cache[names] = v
+        return self._cache[names]
 
     @property
     def R(self) -> np.ndarray:
@@ -56,7 +87,22 @@ class SiteKinematics:
 
     @property
     def omega(self) -> np.ndarray:
-        return _stack(self.c, ("p", "q", "r"))
+        """(n, 3) body angular velocity at the rows' instants [rad/s]."""
+        if "omega" not in self._cache:
+            om = _stack(self.c, ("p", "q", "r"))
+            h = self._half_step()
+            self._cache["omega"] = om if h is None else om + h * _stack(self.c, ("dp", "dq", "dr"))
+        return self._cache["omega"]
+
+    @property
+    def nu(self) -> np.ndarray:
+        """(n, 3) body velocity of the origin over ground at the rows' instants [m/s]."""
+        return self._centred(("u", "v", "w"))
+
+    @property
+    def nu_r(self) -> np.ndarray:
+        """(n, 3) body velocity of the origin through the water at the rows' instants [m/s]."""
+        return self._centred(("u_r", "v_r", "w_r"))
 
     def position(self) -> np.ndarray:
         """(n, 3) north, east, down of the site [m]."""
@@ -64,7 +110,7 @@ class SiteKinematics:
 
     def velocity_body(self, through_water: bool = False) -> np.ndarray:
         """(n, 3) velocity of the site in body axes [m/s], over ground or through the water."""
-        v = _stack(self.c, ("u_r", "v_r", "w_r") if through_water else ("u", "v", "w"))
+        v = self.nu_r if through_water else self.nu
         return v + np.cross(self.omega, self.r)
 
     def velocity_world(self) -> np.ndarray:
@@ -74,8 +120,7 @@ class SiteKinematics:
     def specific_force(self) -> np.ndarray:
         """(n, 3) specific force at the site in body axes [m/s²] (accelerometer truth)."""
         om = self.omega
-        nu1 = _stack(self.c, ("u", "v", "w"))
-        a = (_stack(self.c, ("du", "dv", "dw")) + np.cross(om, nu1)
+        a = (_stack(self.c, ("du", "dv", "dw")) + np.cross(om, self.nu)
              + np.cross(_stack(self.c, ("dp", "dq", "dr")), self.r) + np.cross(om, np.cross(om, self.r)))
         g_body = G * self.R[:, 2, :]  # Rᵀ (0, 0, g): third row of R
         return a - g_body

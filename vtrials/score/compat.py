@@ -21,12 +21,14 @@ noise enters as the slope of its integral, a Wiener process (standard deviation 
 2·10⁻⁷ rad/s for the navigation unit over 90 s, a tenth of the smallest bound). The invariant combinations' references use the true mean roll and
 pitch of the window.
 
-Timing of the simulator's truth: its body rates p, q, r (and so the IMU's gyros) describe the time step
-that ENDS at their stamp (semi-implicit integration: the velocity of step n carries the pose from n − 1
-to n), half a step behind the attitude of the same row. Integrating the true rates with exact
-kinematics reproduces the true Euler angles 0.025 s earlier to 2·10⁻⁵ rad, and at the stamped instant
-only to 2·10⁻³ rad RMS in roll in a State 4 sea (tests/test_compat_records.py). Reconstructed states are
-therefore scored both at the stamped instant and half a step earlier (``rate_lag_s``).
+Timing of the simulator's truth: the truth file's body rates p, q, r and velocities describe the time
+step that ENDS at their stamp (semi-implicit integration: the velocity of step n carries the pose from
+n − 1 to n), half a step behind the attitude of the same row. Integrating them with exact kinematics
+reproduces the true Euler angles half a step earlier to 2·10⁻⁵ rad, and at the stamped instant only to
+2·10⁻³ rad RMS in roll in a State 4 sea (tests/test_compat_records.py). The instruments, and this
+scorer's references, carry them forward to the row's instant (:class:`vtrials.instruments.kinematics.
+SiteKinematics` with the integrator step, ``truth_columns(..., step_s)``), so states are scored at the
+stamped instant; ``rate_lag_s`` (default 0) can still shift the comparison.
 
 True states: roll, pitch (Euler angles of the hull frame), the body velocities through the water
 (u_r, v_r, w_r: with a log and v ≈ 0 the fit reconstructs water-relative velocities; with GNSS aiding
@@ -40,7 +42,7 @@ import math
 
 import numpy as np
 
-from vtrials.instruments.kinematics import SiteKinematics, rotation_matrices
+from vtrials.instruments.kinematics import SiteKinematics
 from vtrials.units import G
 
 IMU_CHANNELS = (("b_ax", "ax"), ("b_ay", "ay"), ("b_az", "az"), ("b_p", "p"), ("b_q", "q"), ("b_r", "r"))
@@ -48,10 +50,14 @@ _COLS = ("x", "y", "z", "qw", "qx", "qy", "qz", "roll", "pitch", "heading", "u",
          "u_r", "v_r", "w_r", "du", "dv", "dw", "dp", "dq", "dr", "current_n", "current_e")
 
 
-def truth_columns(truth_vars: dict, t_truth: np.ndarray) -> dict:
-    """The truth columns the scoring needs, from the truth file's variables."""
+def truth_columns(truth_vars: dict, t_truth: np.ndarray, step_s: float | None) -> dict:
+    """The truth columns the scoring needs, from the truth file's variables; ``step_s`` the simulation's
+    time step (the truth file's ``timestep_s``), so that velocities and rates are taken at their rows'
+    instants as the instruments take them (module note), or None for columns already at one instant."""
     cols = {k: np.asarray(truth_vars[k], float) for k in _COLS}
     cols["t"] = np.asarray(t_truth, float)
+    if step_s is not None:
+        cols["step_s"] = np.full(cols["t"].size, float(step_s))
     return cols
 
 
@@ -109,10 +115,13 @@ def _integrated_slope(t: np.ndarray, e: np.ndarray) -> float:
 def true_states(cols: dict, t: np.ndarray) -> dict:
     """True roll, pitch, heading, body velocities (through the water and over ground) and the heave
     velocity (earth-down velocity of the reference point) at times t."""
-    out = {k: np.interp(t, cols["t"], cols[k]) for k in ("roll", "pitch", "u", "v", "w", "u_r", "v_r", "w_r")}
+    kin = SiteKinematics(cols, np.zeros(3))
+    out = {k: np.interp(t, cols["t"], cols[k]) for k in ("roll", "pitch")}
+    for j, k in enumerate(("u", "v", "w")):
+        out[k] = np.interp(t, cols["t"], kin.nu[:, j])
+        out[f"{k}_r"] = np.interp(t, cols["t"], kin.nu_r[:, j])
     out["heading"] = np.interp(t, cols["t"], np.unwrap(cols["heading"]))
-    R = rotation_matrices(cols["qw"], cols["qx"], cols["qy"], cols["qz"])
-    v_down = np.einsum("nj,nj->n", R[:, 2, :], np.column_stack([cols["u"], cols["v"], cols["w"]]))
+    v_down = np.einsum("nj,nj->n", kin.R[:, 2, :], kin.nu)
     out["v_down"] = np.interp(t, cols["t"], v_down)
     return out
 

@@ -75,8 +75,12 @@ class Driver:
         return float(self.sim.time[ship])
 
     def columns(self, rows: np.ndarray) -> dict:
-        """Truth rows (K, width) of one ship as named columns, with the track through the water."""
+        """Truth rows (K, width) of one ship as named columns, with the track through the water and the
+        integrator step ``step_s``."""
         cols = {n: rows[:, j] for j, n in enumerate(self.names)}
+        # the integrator step: the rows' velocities are the step's (half a step before the row's
+        # instant), which vtrials.instruments.kinematics carries forward
+        cols["step_s"] = np.full(rows.shape[0], self.sim.dt)
         cols["x_w"] = cols["x"] - cols["drift_n"]
         cols["y_w"] = cols["y"] - cols["drift_e"]
         return cols
