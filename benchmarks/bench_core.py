@@ -90,9 +90,9 @@ def timestep_study(vessel, speed, dt0, t_turn, t_zz):
         sim.set_helm(1, [(H.ZIGZAG, math.radians(20), math.radians(20), 0.0, 1.0)])
         sim.step(int(round(max(t_turn, t_zz) / dt)))
         rec = sim.truth()
-        c = ship_columns(rec, sim.rec_names, 0)
+        c = ship_columns(rec, sim.rec_names, 0, sim.dt)
         mt = TM.turning(c["t"], c["x_w"], c["y_w"], c["heading"], c["u_r"], c["v_r"], c["r"])
-        c = ship_columns(rec, sim.rec_names, 1)
+        c = ship_columns(rec, sim.rec_names, 1, sim.dt)
         mz = TM.zigzag(c["t"], c["heading"], rudder_deg=20, heading_deg=20, first_side=1)
         rows.append((dt, mt["advance_m"], mt["tactical_diameter_m"], mz["first_overshoot_deg"],
                      mz["second_overshoot_deg"]))

@@ -44,7 +44,7 @@ def main() -> None:
     t0 = time.perf_counter()
     sim.step(n)
     t_sim = time.perf_counter() - t0
-    cols = {k: np.ascontiguousarray(v) for k, v in ship_columns(sim.truth(), sim.rec_names, 0).items()}
+    cols = {k: np.ascontiguousarray(v) for k, v in ship_columns(sim.truth(), sim.rec_names, 0, sim.dt).items()}
     rows = cols["t"].size
     out = {"simulated_s": a.seconds, "truth_rate_hz": 1 / dt, "rows": rows, "instruments": None,
            "simulation_wall_s": t_sim, "chunks": {}}

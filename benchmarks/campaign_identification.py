@@ -199,9 +199,26 @@ def _replicate(args) -> dict:
     return row
 
 
+def _levelled_truth(g, step_s: float, t) -> dict:
+    """The true states the navigation filter estimates (:mod:`vtrials.sysid.navfilter`), at times ``t``:
+    the velocity of the reference point (midship, waterline) along and across the heading in the
+    horizontal plane and the heading rate, from the truth group ``g`` with its velocities and rates
+    taken at the rows' instants (:class:`vtrials.instruments.kinematics.SiteKinematics`)."""
+    from vtrials.instruments.kinematics import SiteKinematics
+    from vtrials.score.compat import truth_columns
+    cols = truth_columns(g, g["time"][:], step_s)
+    kin = SiteKinematics(cols, np.zeros(3))
+    (u, v, w), (_, q, r) = kin.nu.T, kin.omega.T
+    ph, th = cols["roll"], cols["pitch"]
+    sp, cp, st, ct = np.sin(ph), np.cos(ph), np.sin(th), np.cos(th)
+    lev = {"u": ct * u + st * (sp * v + cp * w), "v": cp * v - sp * w, "r": (q * sp + r * cp) / ct}
+    return {k: np.interp(t, cols["t"], x) for k, x in lev.items()}
+
+
 def _smoother(args) -> dict:
     """One replicate's smoother check: every maneuver reconstructed from its records and compared with
-    the truth (u, v, r at midship): RMS error and the fraction of samples inside ±1.96 σ."""
+    the truth of what the filter estimates (midship, levelled heading frame, at the rows' instants:
+    :func:`_levelled_truth`): RMS error and the fraction of samples inside ±1.96 σ."""
     ship, i, seed, tmp = args
     import h5py
     import vtrials
@@ -212,13 +229,13 @@ def _smoother(args) -> dict:
     try:
         vtrials.run(str(_scenario(ship, seed, 1, work)), str(work / "run"), plot=False)
         with h5py.File(work / "run" / "truth.nc") as truth:
+            step = float(truth.attrs["timestep_s"][0])
             for p in sorted((work / "run" / "records").glob("*.nc")):
                 mr = RE.read_maneuver(p)
                 sol = RE.reconstruct(mr)
-                g = truth[mr.name]
-                c = np.cos(np.interp(sol.t, g["time"][:], g["roll"][:]))   # levelled frame: v, r ÷ cos φ
-                for k, col in (("u", "u_r"), ("v", "v_r"), ("r", "r")):
-                    e = sol.state(k) - np.interp(sol.t, g["time"][:], g[col][:]) / (1.0 if k == "u" else c)
+                tru = _levelled_truth(truth[mr.name], step, sol.t)
+                for k in ("u", "v", "r"):
+                    e = sol.state(k) - tru[k]
                     out["states"].setdefault(k, []).append(
                         (float(np.sqrt(np.mean(e**2))), float(np.mean(np.abs(e) <= 1.96 * sol.sigma(k)))))
     finally:

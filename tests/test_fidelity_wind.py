@@ -110,7 +110,7 @@ def test_anemometer_reads_the_simulated_wind_profile(exponent, z_ref):
     sim = Simulator(scn.vessel, 1, 0.05, environment_block(scn), planar=True)
     sim.set_state(0, ShipState(shaft_rps=(0.0,) * sim.ns))
     sim.step(400)  # 20 s at rest in slack water: the wind moves a VLCC by mm/s
-    cols = ship_columns(sim.truth(), sim.rec_names, 0)
+    cols = ship_columns(sim.truth(), sim.rec_names, 0, sim.dt)
     iset = instrument_set(scn)
     iset.reset()
     iset.process(cols)

@@ -103,7 +103,7 @@ def test_planar_mode_converges_to_reference(n_ref):
         sim.step(int(round(70.0 / dt)))
         from vtrials.truth.columns import ship_columns
         from vtrials.truth import metrics as TM
-        c = ship_columns(sim.truth(), sim.rec_names, 0)
+        c = ship_columns(sim.truth(), sim.rec_names, 0, sim.dt)
         m = TM.turning(c["t"], c["x_w"], c["y_w"], c["heading"], c["u_r"], c["v_r"], c["r"])
         errs.append(abs(m["tactical_diameter_m"] / res["tactical_diameter_m"] - 1)
                     + abs(m["advance_m"] / res["advance_m"] - 1))

@@ -99,7 +99,7 @@ def runs():
     sim.set_helm(0, [(H.HEADING, 0.0, limit, *gains, APPROACH_S),
                      (H.ZIGZAG, RUDDER, SWITCH, 0.0, 1.0, 4.0), (H.HOLD, 0.0)])
     sim.step(int(round(DURATION_S / DT)))
-    out["built-in"] = ship_columns(sim.truth(), sim.rec_names, 0)
+    out["built-in"] = ship_columns(sim.truth(), sim.rec_names, 0, sim.dt)
     # driven from outside through the driver
     sim = Simulator(v, 1, DT)
     sim.set_state(0, s0)

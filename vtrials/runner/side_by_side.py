@@ -173,7 +173,7 @@ def simulate(scn: Scenario, nthread: int = 1, progress=None) -> RunResult:
     names = sim.rec_names
     runs = []
     for i, m in enumerate(scn.maneuvers):
-        cols = ship_columns(rec, names, i)
+        cols = ship_columns(rec, names, i, sim.dt)
         keep = cols["t"] <= t_finex[i] + 1e-9
         cols = {k: v[keep] for k, v in cols.items()}
         ex = cols["t"] >= t_exec[i] - 1e-9

@@ -25,6 +25,7 @@ from typing import Protocol
 import numpy as np
 
 from vtrials.physics.simulator import Simulator
+from vtrials.truth.columns import row_columns
 
 MAX_SLICE_S = 60.0  # longest stretch simulated between two handovers of truth to the instruments
 FLUSH_ALL_S = 600.0  # instruments nobody is watching take their truth in chunks this long
@@ -77,13 +78,7 @@ class Driver:
     def columns(self, rows: np.ndarray) -> dict:
         """Truth rows (K, width) of one ship as named columns, with the track through the water and the
         integrator step ``step_s``."""
-        cols = {n: rows[:, j] for j, n in enumerate(self.names)}
-        # the integrator step: the rows' velocities are the step's (half a step before the row's
-        # instant), which vtrials.instruments.kinematics carries forward
-        cols["step_s"] = np.full(rows.shape[0], self.sim.dt)
-        cols["x_w"] = cols["x"] - cols["drift_n"]
-        cols["y_w"] = cols["y"] - cols["drift_e"]
-        return cols
+        return row_columns(rows, self.names, self.sim.dt)
 
     # ------------------------------------------------------------------ stepping
     def advance_steps(self, n: int) -> None:

@@ -84,7 +84,7 @@ def twin_points(vessel, settings: list[dict], dt: float, window_s: float = 120.0
         for i in range(N):
             if done[i]:
                 continue
-            c = ship_columns(rec, sim.rec_names, i)
+            c = ship_columns(rec, sim.rec_names, i, sim.dt)
             stw = np.hypot(c["u_r"], c["v_r"])
             half = stw.size // 2
             change = abs(float(np.mean(stw[half:]) - np.mean(stw[:half])))

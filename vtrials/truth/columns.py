@@ -74,9 +74,18 @@ def describe(name: str) -> tuple[str, str]:
     raise KeyError(name)
 
 
-def ship_columns(rec: np.ndarray, names: list[str], ship: int) -> dict[str, np.ndarray]:
-    """One ship's truth as a dict of columns, plus the track through the water (x_w, y_w)."""
-    cols = {n: rec[:, ship, j] for j, n in enumerate(names)}
+def row_columns(rows: np.ndarray, names: list[str], step_s: float) -> dict[str, np.ndarray]:
+    """One ship's truth rows (K, width) as a dict of columns, plus the track through the water (x_w,
+    y_w) and the integrator step ``step_s`` [s] of every row: the rows' velocities are those of the step
+    just taken, half a step before the row's instant, and the instruments carry them forward
+    (:mod:`vtrials.instruments.kinematics`)."""
+    cols = {n: rows[:, j] for j, n in enumerate(names)}
     cols["x_w"] = cols["x"] - cols["drift_n"]
     cols["y_w"] = cols["y"] - cols["drift_e"]
+    cols["step_s"] = np.full(rows.shape[0], float(step_s))
     return cols
+
+
+def ship_columns(rec: np.ndarray, names: list[str], ship: int, step_s: float) -> dict[str, np.ndarray]:
+    """Ship ``ship``'s truth from a batch record (K, ships, width): :func:`row_columns`."""
+    return row_columns(rec[:, ship, :], names, step_s)
