@@ -12,7 +12,7 @@ instruments run on their own clocks after (or alongside) the simulation.
 One instant per row. A truth row is MuJoCo's state between steps of its semi-implicit Euler integrator:
 x_{n+1} = x_n + h v_{n+1}, so the pose and the accelerations belong to the row's time t_n and the
 velocities to the step just taken, t_n − h/2 (the position chords confirm it to 1e-9 m/s,
-tests/test_instruments_kinematics.py). A sensor reads all of them at t_n: with the step h (truth
+tests/test_truth_instant.py). A sensor reads all of them at t_n: with the step h (truth
 column ``step_s``, which the drivers write) the velocities are carried half a step forward with the
 row's own accelerations, ν(t_n) = ν + (h/2)(ν̇ + ω × ν) (the world-frame velocity's midpoint, in body
 axes) and ω(t_n) = ω + (h/2) ω̇. Left uncorrected, the half step put the rate gyros 10 ms late

@@ -298,11 +298,14 @@ def read_maneuver(path: str | Path) -> ManeuverRecord:
     if kinds.get("pitch_indicator"):
         pis = kinds["pitch_indicator"]
         pitch = np.mean([np.interp(t, *_channel(rec, i, "pitch")) for i in pis], axis=0)
-        # the zero's stated error, and the hub-oil warming's drift at the power used (its full rise
-        # at the rated power: a bound the team takes as 2 sigma), both common to the record
-        pm = rec.meta(pis[0])
-        pitch_sd = math.hypot(float(pm.get("bias_std", 0.0)),
-                              0.5 * float(pm.get("bias_per_K", 0.0)) * float(pm.get("oil_temperature_rise_K", 0.0)))
+        # each indicator's zero: its stated error and the hub-oil warming's drift (its full rise at the
+        # rated power: a bound the team takes as 2 sigma), common to the record; the indicators are
+        # calibrated one by one, so their zeros are independent and the mean's error is √(Σ σᵢ²)/n,
+        # as for the rudders' synchros
+        sds = [math.hypot(float(pm.get("bias_std", 0.0)),
+                          0.5 * float(pm.get("bias_per_K", 0.0)) * float(pm.get("oil_temperature_rise_K", 0.0)))
+               for pm in (rec.meta(i) for i in pis)]
+        pitch_sd = math.sqrt(sum(x * x for x in sds)) / len(sds)
     return ManeuverRecord(path=path, name=str(rec.attr("trial", Path(path).stem)), kind=str(rec.attr("kind", "")),
                           ordered=rec.attr("maneuver", {}) or {}, ship=str(rec.attr("ship", "")), t=t, f=f_h,
                           psi_rate=psi_rate, roll=phi, aiding=aiding, noise=noise, delta=delta,
