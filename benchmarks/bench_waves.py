@@ -22,7 +22,7 @@ import numpy as np
 
 from vtrials.physics.environment.waves import Waves, realize
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.timedomain import seakeeping_vessel
 from vtrials.physics.simulator import Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
@@ -55,7 +55,7 @@ def main() -> None:
     load_before = os.getloadavg()[0]
     ves = load_vessel("patrol51")
     db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
-    model = fit_radiation(db, dofs=(2, 3, 4))
+    model = memory_model(db)
     calm = Simulator(ves, 1, DT)
     state = calm.self_propulsion(0, 7.0)
     rows = []

@@ -42,7 +42,7 @@ from vtrials.physics import steering as H
 from vtrials.physics.environment.waves import elevation_at
 from vtrials.physics.seakeeping import linearize as LZ
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.sea_ship import sea_ship
 from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
 from vtrials.physics.simulator import ShipState, Simulator
@@ -151,7 +151,7 @@ def main(argv=None) -> None:
     a = ap.parse_args(argv)
     ves = load_vessel("patrol51")
     db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
-    model = fit_radiation(db, dofs=(2, 3, 4))
+    model = memory_model(db)
     rd = roll_damping_of(ves, db)
     t_start = time.time()
     surge = []

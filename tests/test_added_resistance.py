@@ -20,6 +20,7 @@ following, zero speed) equals, within 10 % (issue 10), the spectral integral of 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -30,7 +31,7 @@ from vtrials.physics.environment.waves import realize
 from vtrials.physics.forces import added_resistance as AR
 from vtrials.physics.forces.registry import Component
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.sea_ship import sea_ship
 from vtrials.physics import steering as H
 from vtrials.physics.environment.waves import Waves, spectrum, peak_frequency
@@ -55,9 +56,9 @@ def test_hull_data_of_patrol51(patrol):
     assert h.C_B == pytest.approx(357.0 / (51.5 * 8.6 * 2.3))
     assert h.k_yy == pytest.approx(10.999577092597752 / 51.5)
     # the parametric waterline reaches 99 % of B just forward of midship (no parallel body forward)
-    # and just aft of the aft parallel body's end (0.2 L aft of midship) towards the 0.85 B transom
+    # and just aft of the aft parallel body's end (0.05 L aft of midship) towards the 0.75 B transom
     assert 0.4 * 51.5 < h.entrance_length < 0.5 * 51.5
-    assert 0.0 < h.run_length < 0.3 * 51.5
+    assert 0.4 * 51.5 < h.run_length < 0.45 * 51.5
 
 
 @pytest.mark.parametrize("U,psi_deg", [(7.0, 10.0), (7.0, 45.0), (7.0, 225.0), (4.0, 190.0), (0.0, 10.0)],
@@ -65,7 +66,11 @@ def test_hull_data_of_patrol51(patrol):
 def test_component_mean_equals_spectral_integral(patrol, U, psi_deg):
     ves, db, hull = patrol
     scn = load_scenario(SEA3)
-    field = wave_field(scn)
+    # the scenario's sea with 3000 components instead of 150: the component sum samples the directional
+    # spectrum (each component's direction is drawn), so with 150 its error is a sampling error of
+    # ~CV/√150 (5–12 % here, the response being peaked in direction); 3000 make it ~2 %
+    field = realize(dataclasses.replace(scn.waves, n_components=3000), scn.environment.water_depth_m,
+                    np.random.default_rng(2027))
     comp = field.components
     psi = math.radians(psi_deg)        # the sea comes from 010° (travels towards 190°): ψ = 10° is head seas
     v = ves
@@ -94,7 +99,7 @@ def test_component_mean_equals_spectral_integral(patrol, U, psi_deg):
     print(f"U {U} ψ {psi_deg}°: component sum {r_td:.1f} N, spectral integral {r_spec:.1f} N "
           f"({r_td / r_spec - 1:+.2%}); m0 of the grid {m0:.4f} vs H_s²/16 {0.88 ** 2 / 16:.4f}")
     assert m0 == pytest.approx(0.88 ** 2 / 16, rel=0.02)
-    assert abs(r_td - r_spec) <= 0.10 * abs(r_spec), (r_td, r_spec)
+    assert abs(r_td - r_spec) <= 0.05 * abs(r_spec), (r_td, r_spec)   # measured 0.1–1.4 %
 
 
 def test_regular_wave_limits(patrol):
@@ -132,7 +137,7 @@ def test_self_propelled_speed_loss_matches_the_added_resistance(patrol):
         Component("added_resistance", "added_resistance", AR.pack(hull, comp))])
     pred = pred_sim.steady_at_order(0, rps)
     R_pred = -float(pred_sim.comp_w[0, pred_sim.comp_names.index("added_resistance"), 0])
-    v2, _ = sea_ship(ves, db, comp, DT, model=fit_radiation(db, dofs=(2, 3, 4)), mean_force="snnm")
+    v2, _ = sea_ship(ves, db, comp, DT, model=memory_model(db), mean_force="snnm")
     sim = Simulator(v2, 1, DT)
     sim.set_state(0, s0)
     for k, n in enumerate(rps):

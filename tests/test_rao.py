@@ -196,7 +196,7 @@ def test_coupled_rao_reduces_to_held_rao():
     bv[3, 3] = 3.0e5
     Jv = -bv
     for beta in (math.pi / 2, 3 * math.pi / 4):
-        c = LZ.coupled_rao(ves, db, w, beta, 0.0, Jv, -db.C, np.zeros((6, 6)))
+        c = LZ.coupled_rao(ves, db, w, beta, 0.0, Jv, -db.C, np.zeros((6, 6)), memory_dofs=DOFS)
         h = rao_mod.rao(db, w, beta, 0.0, DOFS, M=M_RB, C=db.C, B_visc=bv)
         for d in DOFS:
             assert np.allclose(c[:, d], h[:, d], rtol=1e-4, atol=1e-6 * np.abs(h[:, d]).max()), (beta, d)

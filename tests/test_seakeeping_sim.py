@@ -31,7 +31,7 @@ from vtrials.physics import steering as H
 from vtrials.physics.seakeeping import linearize as LZ
 from vtrials.physics.seakeeping import rao as rao_mod
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
@@ -44,7 +44,7 @@ AMP = 0.05
 def patrol():
     ves = load_vessel("patrol51")
     db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
-    return ves, db, fit_radiation(db, dofs=(2, 3, 4))
+    return ves, db, memory_model(db)
 
 
 def _run(ves, db, model, omega, mu, speed, t_end, dt=DT):
@@ -141,7 +141,8 @@ def test_radiation_states_refuse_another_step(patrol):
 # displaced position) make it drift and turn as a² t²; at 2 mm the heading changes by < 0.003 rad in
 # 400 s, at 1 cm by 0.05–0.4 rad. When the radiation memory's force was taken before its state was
 # advanced, it lagged the kinematics by a step, which turns ω dt of its ω(A − A∞) part into damping:
-# the lightly damped patrol51 roll peak (beam seas, ω 0.86 rad/s) came out at 0.901, 0.963 and 0.986
+# the lightly damped patrol51 roll peak (beam seas, ω 0.86 rad/s, with the earlier stand-in hull and BC93's
+# sway added mass) came out at 0.901, 0.963 and 0.986
 # of this reference at dt = 0.05, 0.02 and 0.01 s. With the memory centred in time: 1.004, 1.008 and
 # 1.008 (heave 0.998, pitch 0.999–1.000 at all three; measured with this test's set-up, 2 mm waves,
 # 400 s, at each step). The scenarios run at 0.05 s: their roll was 10 % too small at resonance.
@@ -151,7 +152,7 @@ def test_radiation_states_refuse_another_step(patrol):
 DT_C = 0.01
 AMP_C = 0.002
 COUPLED_CASES = [  # (beta_deg, U [m/s], omega [rad/s])
-    (90.0, 0.0, 0.6), (90.0, 0.0, 0.86), (90.0, 0.0, 1.2), (135.0, 0.0, 0.86), (45.0, 0.0, 0.86),
+    (90.0, 0.0, 0.3), (90.0, 0.0, 0.6), (90.0, 0.0, 1.14), (90.0, 0.0, 1.2), (135.0, 0.0, 0.86), (45.0, 0.0, 0.86),
     (180.0, 0.0, 0.7),
     (90.0, 5.0, 0.86), (135.0, 5.0, 0.6), (45.0, 5.0, 0.86), (180.0, 5.0, 0.7),
 ]
@@ -219,8 +220,10 @@ def test_coupled_heave_roll_pitch_match_rao(patrol, linearised, beta_deg, speed,
     peak = np.abs(LZ.coupled_rao(v2, db, w_dense, beta - hd, u_mean, Jv, Je, Jc, rd, AMP_C, **kw)).max(axis=0)
     checked = 0
     for d, col in ((2, "z"), (3, "roll"), (4, "pitch")):
-        if abs(fd[d]) < 0.10 * peak[d] or (d == 3 and beta_deg == 180.0):
-            continue                       # below 10 % of the peak (issue 10), or no roll in head seas
+        long_wave_roll = d == 3 and omega < 0.7 and beta_deg == 90.0 and speed == 0.0
+        if (abs(fd[d]) < 0.10 * peak[d] and not long_wave_roll) or (d == 3 and beta_deg == 180.0):
+            continue                       # below 10 % of the peak (issue 10), or no roll in head seas;
+            # roll in long beam waves is checked however small (the long-wave limit below rests on it)
         checked += 1
         y = r[col][last]
         bb = np.column_stack([basis, np.ones(y.size)])
@@ -228,5 +231,48 @@ def test_coupled_heave_roll_pitch_match_rao(patrol, linearised, beta_deg, speed,
         td = (c[0] + 1j * c[1]) / ce
         err = abs(td - fd[d]) / abs(fd[d])
         print(f"beta {beta_deg} U {u_mean:.2f} omega {omega} {col}: |td| {abs(td):.4g} |fd| {abs(fd[d]):.4g} err {err:.4f}")
+        # roll in long beam waves is the small remainder of two large moments (the Froude–Krylov moment
+        # and that of the sway-coupled inertia) that cancel to the wave slope, so a memory fit error in the
+        # sway–roll A24(ω) − A∞ shows up several-fold: with the first admissible fits (1–2 % of the pair's
+        # peak) roll was 6.9 % off at 0.3 rad/s; with the most accurate ones (radiation.fit_radiation
+        # ``extra``) 1.2 % at 0.3, 1.3 % at 0.6, 2.8 % at the resonance 1.14
         assert err <= 0.05, (beta_deg, speed, omega, col, td, fd[d], err)
     assert checked >= 2
+
+
+# The long-wave limit (an analytic reference for the whole model, not only its integration): a ship free to
+# sway, with no sway restoring, in a beam wave much longer than its beam moves with the water — sway
+# amplitude a, heave amplitude a — and heels with the wave slope k a, amplified quasi-statically by
+# 1/(1 − (ω/ω_n)²). This holds only when the wave excitation (Froude–Krylov of the meshed hull, with the
+# diffraction that carries its A22(ω), A42(ω)) meets the same hull in the dynamics: the same waterplane
+# (BM_T) in the restoring and the same sway and sway–roll added mass. Measured (coupled RAO, zero speed,
+# ω 0.2 / 0.25 / 0.3 rad/s, λ 1540 / 986 / 685 m): roll ÷ slope 1.081 / 1.120 / 1.126 against the
+# quasi-static 1.032 / 1.051 / 1.074; sway 0.992 / 1.014 / 1.001; heave 1.000 / 0.999 / 1.000.
+# Before the stand-in hull was fitted to BC93's KM and the sway added mass taken from the database,
+# roll ÷ slope was 4.7–5.0 (2.8–2.9 with the refitted hull but BC93's Y_v̇ and antisymmetric Y_ṗ = −K_v̇,
+# 1.5–1.6 with BC93's Y_v̇ alone). Below 0.2 rad/s the database has no data (its excitation is held at
+# its lowest frequency), so the test stops there.
+LONG_WAVES = (0.2, 0.25, 0.3)
+
+
+def test_long_beam_waves_sway_with_the_water_and_heel_with_the_slope(patrol, linearised):
+    ves, db, model = patrol
+    rd, lin = linearised
+    start, Jv, Je, Jc, Jd, auto = lin[0.0]
+    v0, _ = seakeeping_vessel(ves, db, np.zeros((0, 6)), DT_C, model=model, drift=False)
+    w = np.array(LONG_WAVES)
+    r = LZ.coupled_rao(v0, db, w, math.pi / 2, 0.0, Jv, Je, Jc, rd, AMP_C)
+    slope = w ** 2 / db.g
+    heel = np.abs(r[:, 3]) / slope
+    # the simulated ship's own roll natural frequency: the peak of the same RAO
+    wd = np.linspace(0.6, 2.0, 281)
+    wn = float(wd[np.argmax(np.abs(LZ.coupled_rao(v0, db, wd, math.pi / 2, 0.0, Jv, Je, Jc, rd, AMP_C)[:, 3]))])
+    quasi_static = 1.0 / (1.0 - (w / wn) ** 2)
+    print("roll/slope", heel, "quasi-static", quasi_static, "omega_n", wn)
+    print("sway", np.abs(r[:, 1]), "heave", np.abs(r[:, 2]))
+    assert np.all(np.abs(heel / quasi_static - 1.0) < 0.10), (heel, quasi_static)
+    assert np.all(np.abs(np.abs(r[:, 1]) - 1.0) < 0.03), np.abs(r[:, 1])
+    assert np.all(np.abs(np.abs(r[:, 2]) - 1.0) < 0.01), np.abs(r[:, 2])
+    # in phase with the slope (starboard down as the crest passes to starboard), to a few degrees
+    lag = np.degrees(np.angle(r[:, 3] / (1j * slope)))
+    assert np.all(np.abs(lag) < 5.0), lag

@@ -37,7 +37,7 @@ from vtrials.physics.forces import context as L
 from vtrials.physics.forces.registry import Component, register
 from vtrials.physics.seakeeping import rao as rao_mod
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.sea_ship import sea_ship
 from vtrials.physics.seakeeping.timedomain import roll_damping_of
 from vtrials.physics.simulator import ShipState, Simulator
@@ -79,7 +79,7 @@ def restraint(ves, surge: bool) -> Component:
 def patrol():
     ves = load_vessel("patrol51")
     db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
-    return ves, db, fit_radiation(db, dofs=(2, 3, 4))
+    return ves, db, memory_model(db)
 
 
 def _sea(db, direction_deg, hs=HS):
@@ -117,10 +117,11 @@ def test_creep_at_zero_speed_is_the_missing_added_mass_coriolis_force(patrol):
 
 @pytest.mark.parametrize("direction_deg,beta,hs,asserted,mean_force", [
     (0.0, math.pi, HS, (2, 4), "database"),
-    # beam seas: H_s 0.5 m and no mean force; with H_s 1.5 m the nearly undamped roll (≈ 0.3 rad RMS at
-    # zero speed, patrol51's roll damping is in its speed-dependent hull model) turns the ship through the
-    # hull's roll-yaw couplings beyond what the soft restraint holds (heading to 1.2 rad)
-    (270.0, 0.5 * math.pi, 0.5, (2, 4), "none")], ids=["head", "beam"])
+    # beam seas: H_s 0.25 m and no mean force. Pitch in beam seas is tiny (0.008° RMS here) and the roll's
+    # second-order terms add to it: at H_s 0.5 m (roll 4.4° RMS) the pitch was +11 % over this linear
+    # reference, at 0.25 m (2.3°) +4 %. Roll is not asserted against this held-DOF reference: the ship is
+    # free to sway (−34 % here); tests/test_seakeeping_sim.py checks roll against the coupled RAO
+    (270.0, 0.5 * math.pi, 0.25, (2, 4), "none")], ids=["head", "beam"])
 def test_zero_speed_rms_motions_match_rao(patrol, direction_deg, beta, hs, asserted, mean_force):
     ves, db, model = patrol
     comp = _sea(db, direction_deg, hs)

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.sea_ship import sea_ship
 from vtrials.physics.seakeeping.timedomain import seakeeping_vessel
 from vtrials.physics.simulator import ShipState, Simulator
@@ -32,7 +32,7 @@ DT = 0.02
 def patrol():
     ves = load_vessel("patrol51")
     db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
-    return ves, db, fit_radiation(db, dofs=(2, 3, 4))
+    return ves, db, memory_model(db)
 
 
 def test_drift_wrench_matches_database(patrol):

@@ -4,11 +4,16 @@ The team's model file (models/<ship>/design/<ship>_design_rao.nc, written offlin
 ``python -m vtrials.physics.seakeeping.design``; README.md beside it states how it differs from the
 simulator's truth) holds zero-speed BEM coefficients of the design mesh, the design mass and restoring
 matrices and a fixed linear roll damping. The RAO at forward speed U is the design office's usual
-encounter-frequency correction and nothing more (e.g. Lloyd 1989, "Seakeeping", §§ 5, 9):
+encounter-frequency correction and a roll damping growing with speed (the file's ``roll_damping_per_speed``,
+e.g. Ikeda's hull lift) and nothing more (e.g. Lloyd 1989, "Seakeeping", §§ 5, 9):
 
-    [−ω_e² (M + A(|ω_e|)) + iω_e (B(|ω_e|) + B_44) + C] ξ̂ = X(ω, μ),   ω_e = ω − ω² U cos μ / g,
+    [−ω_e² (M + A(|ω_e|)) + iω_e (B(|ω_e|) + B_44 + U B_44,U) + C] ξ̂ = X(ω, μ),   ω_e = ω − ω² U cos μ / g,
 
-for ξ = (heave z down, roll φ, pitch θ) at the body origin O, surge, sway and yaw held; e^{+iω_e t},
+for ξ over the file's free DOFs (``free_dofs``: sway, heave, roll, pitch and yaw in the current files, as
+strip theory couples them, Salvesen, Tuck & Faltinsen 1970; heave, roll and pitch alone in older ones),
+surge held, sway and yaw without restoring; the RAOs returned are heave (z down), roll φ and pitch θ at
+the body origin O. Where |ω_e| < :data:`OMEGA_E_FREE` (following seas near ω_e = 0) sway and yaw, which
+have no restoring, are held instead (their response is undefined there); e^{+iω_e t},
 crest at O at t = 0 (the file's convention). μ is the direction the waves travel relative to the
 heading (0 following, π head seas, +π/2 travelling to starboard); the file stores 0 ≤ μ ≤ π and the
 other side follows by port–starboard symmetry (roll changes sign). Outside the file's frequencies:
@@ -30,8 +35,11 @@ import numpy as np
 from vtrials.errors import InputError
 from vtrials.records.design import read_team_model
 
-FREE = (2, 3, 4)                        # heave, roll, pitch
-MIRROR = np.array([1.0, -1.0, 1.0])     # y → −y: roll changes sign
+FREE = (2, 3, 4)                        # heave, roll, pitch: the outputs (and the free DOFs of older files)
+SIGN_Y = np.array([1.0, -1.0, 1.0, -1.0, 1.0, -1.0])   # y → −y: sway, roll and yaw change sign
+SYMMETRIC_DOFS = (0, 2, 4)              # surge, heave, pitch (port–starboard symmetric modes)
+#: Encounter frequency [rad/s] below which sway and yaw (no restoring) are held (module doc).
+OMEGA_E_FREE = 0.05
 MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
 
 
@@ -50,23 +58,35 @@ class DesignRAO:
         self.attrs = attrs
         self.omega = np.asarray(data["omega"], dtype=float)
         self.headings = np.asarray(data["heading"], dtype=float)
-        ix = np.ix_(range(self.omega.size), FREE, FREE)
-        self.A = data["added_mass"][ix]
-        self.B = data["radiation_damping"][ix]
-        sub = np.ix_(FREE, FREE)
-        self.A_inf = data["added_mass_infinite_frequency"][sub]
-        self.M = data["rigid_body_mass"][sub]
-        self.C = data["restoring"][sub]
+        free = tuple(int(d) for d in json.loads(attrs.get("free_dofs", "[2, 3, 4]")))
+        if not set(FREE) <= set(free) or not set(free) <= {1, 2, 3, 4, 5}:
+            raise InputError(str(path), "free_dofs", f"{list(free)}: must include heave, roll and pitch (2, 3, 4) "
+                             "and only sway, heave, roll, pitch, yaw (1-5)")
+        self.free = free
+        self._out = [free.index(d) for d in FREE]                  # heave, roll, pitch within the free DOFs
+        self._horiz = [k for k, d in enumerate(free) if d in (1, 5)]
+        ix = np.ix_(range(self.omega.size), free, free)
+        self.A = np.array(data["added_mass"][ix], dtype=float)
+        self.B = np.array(data["radiation_damping"][ix], dtype=float)
+        sub = np.ix_(free, free)
+        self.A_inf = np.array(data["added_mass_infinite_frequency"][sub], dtype=float)
+        self.M = np.array(data["rigid_body_mass"][sub], dtype=float)
+        self.C = np.array(data["restoring"][sub], dtype=float)
         self.B44 = float(attrs["roll_damping_linear"])
-        self.X = (data["excitation_force_re"] + 1j * data["excitation_force_im"])[:, :, list(FREE)]
-        # port–starboard symmetry of the hull: roll is uncoupled from heave and pitch (the BEM's and the
-        # mesh hydrostatics' numerical roll couplings, ~1e-4 of the diagonals, are set to zero)
+        self.B44_per_speed = float(attrs.get("roll_damping_per_speed", 0.0))   # [N m s per m/s]
+        self.X = (data["excitation_force_re"] + 1j * data["excitation_force_im"])[:, :, list(free)]
+        self._mirror = SIGN_Y[list(free)]
+        # port–starboard symmetry of the hull: the symmetric modes (heave, pitch) are uncoupled from the
+        # antisymmetric ones (sway, roll, yaw); the BEM's and the mesh hydrostatics' numerical couplings,
+        # ~1e-4 of the diagonals, are set to zero
+        sym = [k for k, d in enumerate(free) if d in SYMMETRIC_DOFS]
+        anti = [k for k, d in enumerate(free) if d not in SYMMETRIC_DOFS]
         for a in (self.A, self.B):
-            a[:, 1, [0, 2]] = 0.0
-            a[:, [0, 2], 1] = 0.0
+            a[np.ix_(range(a.shape[0]), sym, anti)] = 0.0
+            a[np.ix_(range(a.shape[0]), anti, sym)] = 0.0
         for a in (self.A_inf, self.M, self.C):
-            a[1, [0, 2]] = 0.0
-            a[[0, 2], 1] = 0.0
+            a[np.ix_(sym, anti)] = 0.0
+            a[np.ix_(anti, sym)] = 0.0
         self.g = float(attrs["g"])
         self.x_from_midship = float(attrs["reference_x_from_midship"])
         self.design = json.loads(attrs.get("design_toml", "{}"))
@@ -74,7 +94,7 @@ class DesignRAO:
         w_hi = 2.0 * self.omega[-1]
         self._wg = np.concatenate(([0.0], self.omega, [w_hi]))
         self._Ag = np.concatenate((self.A[:1], self.A, self.A_inf[None]), axis=0)
-        z = np.zeros((1, 3, 3))
+        z = np.zeros((1, len(free), len(free)))
         self._Bg = np.concatenate((z, self.B, z), axis=0)
 
     def _coeff(self, grid_vals, w):
@@ -82,10 +102,11 @@ class DesignRAO:
         out = np.empty((w.size, flat.shape[1]))
         for c in range(flat.shape[1]):
             out[:, c] = np.interp(w, self._wg, flat[:, c])
-        return out.reshape((w.size, 3, 3))
+        n = len(self.free)
+        return out.reshape((w.size, n, n))
 
     def excitation(self, omega, mu) -> np.ndarray:
-        """X (…, 3) [N/m, N m/m] of heave, roll, pitch at wave frequencies ω and directions μ (broadcast)."""
+        """X (…, n) [N/m, N m/m] of the free DOFs at wave frequencies ω and directions μ (broadcast)."""
         w, m = np.broadcast_arrays(np.asarray(omega, dtype=float), np.asarray(mu, dtype=float))
         b = np.remainder(m + math.pi, 2.0 * math.pi) - math.pi      # [−π, π)
         sgn = np.where(b < 0.0, -1.0, 1.0)
@@ -100,7 +121,7 @@ class DesignRAO:
         x = ((1 - fw)[..., None] * ((1 - fb)[..., None] * X[jw, jb] + fb[..., None] * X[jw, jb + 1])
              + fw[..., None] * ((1 - fb)[..., None] * X[jw + 1, jb] + fb[..., None] * X[jw + 1, jb + 1]))
         x = np.where((w > om[-1])[..., None], 0.0, x)
-        mirror = np.where(sgn[..., None] < 0.0, MIRROR, 1.0)
+        mirror = np.where(sgn[..., None] < 0.0, self._mirror, 1.0)
         return x * mirror
 
     def rao(self, omega, mu, U: float) -> np.ndarray:
@@ -119,10 +140,22 @@ class DesignRAO:
         awe = np.abs(we)
         A = self._coeff(self._Ag, awe)
         Bc = self._coeff(self._Bg, awe)
-        Bc[:, 1, 1] += self.B44
+        r = self._out[1]
+        Bc[:, r, r] += self.B44 + self.B44_per_speed * U
         Z = -(we ** 2)[:, None, None] * (self.M + A) + 1j * we[:, None, None] * Bc + self.C
         X = self.excitation(w, m)
-        out = np.linalg.solve(Z, X[..., None])[..., 0]
+        held = awe < OMEGA_E_FREE
+        if self._horiz and np.any(held):            # sway and yaw held: unit rows and columns, no force
+            h = self._horiz
+            Zh = Z[held]
+            Zh[:, h, :] = 0.0
+            Zh[:, :, h] = 0.0
+            Zh[:, h, h] = 1.0
+            Z[held] = Zh
+            Xh = X[held]
+            Xh[:, h] = 0.0
+            X[held] = Xh
+        out = np.linalg.solve(Z, X[..., None])[..., 0][:, self._out]
         return np.moveaxis(out, -1, 0).reshape((3,) + shape)
 
     def vertical(self, rao, x: float, y: float = 0.0) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 
 from vtrials.physics.seakeeping import linearize as LZ
 from vtrials.physics.seakeeping.database import load_database
-from vtrials.physics.seakeeping.radiation import fit_radiation
+from vtrials.physics.seakeeping.timedomain import memory_model
 from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
 from vtrials.physics.simulator import Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
@@ -28,7 +28,7 @@ class TruthRAO:
     def __init__(self, ship: str, U: float, dt: float = 0.05):
         self.vessel = load_vessel(ship)
         self.db = load_database(model_dir(ship) / "hydro" / f"{ship}_hydro.nc")
-        model = fit_radiation(self.db, dofs=(2, 3, 4))
+        model = memory_model(self.db)
         start = Simulator(self.vessel, 1, dt).self_propulsion(0, U)
         self.U = float(start.u)
         self.v0, _ = seakeeping_vessel(self.vessel, self.db, np.zeros((0, 6)), dt, model=model, drift=False)

@@ -437,23 +437,18 @@ def _time_domain_section(setup: ShipSetup, C: np.ndarray) -> list:
            "* Roll damping: the radiation memory gives the wave part; the viscous part is the `roll_damping` "
            "component set by the `[roll_damping]` table of `hull.toml` (method, bilge keels, each with its source); "
            "every roll damping term of the maneuvering model is removed from the seakeeping vessel.",
-           "* Horizontal DOFs: surge, sway and yaw keep the maneuvering model (its added mass and hull forces, no "
-           "memory); the database's sway and yaw coefficients are not used by the simulator."]
+           "* Surge and yaw keep the maneuvering model (its added mass and hull forces, no memory). Sway keeps "
+           "the maneuvering model's hull forces, but its added mass and its coupling with roll are this database's "
+           "A∞ with the radiation memory of sway, sway–roll and roll–sway (so that in long beam waves the ship "
+           "sways with the water and heels with the wave slope: the diffraction part of the excitation carries "
+           "this hull's A22(ω) and A42(ω)); `linearize.coupled_rao` is the frequency-domain model of the same "
+           "system."]
     if setup.name == "patrol51":
-        out += ["* Known inconsistency (not resolved here): the wave excitation is the meshed hull's, whose "
-                "waterplane gives BM_T 4.44 m where BC93's KM − KB gives 2.94 m, while the restoring is BC93's "
-                "GM_T 1.1 m. The roll excitation is therefore large for the restoring it meets: in beam seas at the "
-                "roll resonance (0.86 rad/s in the simulator) the roll RAO is ≈ 2.6 rad per metre of wave amplitude "
-                "at zero speed (roll/wave slope ≈ 35); a JONSWAP beam sea of H_s 1.5 m, T_p 8 s rolled it to 62° at 5 m/s in the simulator. A consistent "
-                "model needs a hull mesh with BC93's waterplane (C_WP ≈ 0.61, see `vtrials.resistance`) and a "
-                "rebuilt database.",
-                "* Sway–roll coupling: with the maneuvering model's sway added mass and roll coupling (BC93 Y_v̇, "
-                "Y_ṗ, K_v̇) and this database's A44(ω) about O (computed with sway held), the simulated ship's roll "
-                "resonance is at 0.86 rad/s (T 7.3 s). The database's own free-ship RAO (its sway A22, A24(ω), "
-                "B22 free) peaks near 1.0–1.1 rad/s and is ≈ 6 times smaller at 0.86 rad/s: the roll added inertia "
-                "about O measured with sway held is partly sway-coupling inertia that a ship free to sway does "
-                "not feel. The simulator is matched by `linearize.coupled_rao` (its own coupled system), not by "
-                "the database's free-ship RAO."]
+        out += ["* Sway added mass: in waves the simulator's sway added mass at maneuvering frequencies is this "
+                "hull's A22(ω → 0) (3.3e5 kg at 0.2 rad/s), not BC93's Y_v̇ 3.93e5 kg, and its sway–roll coupling the "
+                "symmetric potential-flow A24 rather than BC93's antisymmetric Y_ṗ = −K_v̇ (with those, the "
+                "ship heeled 2.8–3.4 times the wave slope in beam waves of 0.2–0.5 rad/s even with this waterplane; "
+                "with BC93's Y_v̇ alone, 1.5–1.7 times)."]
     return out
 
 
@@ -510,13 +505,12 @@ def build(ship: str, models_dir: Path = MODELS_DIR, n_threads: int = 2, levels: 
             f"vs {mh['GM_L']} m (an estimate in ship.toml); x_F {hyd['x_F'] - setup.origin_x:.2f} m from O vs "
             f"{mh['x_F']} m (an assumption in ship.toml).")
     if setup.name == "patrol51":
-        note += (" The patrol51 roll stiffness differs by far more than a few per cent: with B = 8.6 m and the "
-                 "ship.toml waterplane (C_WP 0.72), BM_T = I_T/∇ cannot be as small as BC93's KM − KB = 2.94 m "
-                 "for any realistic waterline (even a rectangular waterplane of width 0.72 B gives 2.85 m; "
-                 "the waterline families tried here give 4.2–4.8 m). Either the ship.toml C_WP 0.72 is too "
-                 "high (vtrials.resistance uses 0.65 and notes 0.61 matches the published BM) or the beam at "
-                 "the waterline is less than 8.6 m. The time-domain model uses ship.toml's GM_T; the "
-                 "database's roll excitation belongs to the meshed hull. This is a known inconsistency.")
+        note += (" The stand-in hull's C_WP (hull.toml) is fitted so that the mesh's KB + BM_T equals BC93's KM "
+                 "(KG 3.36 + GM_T 1.1 = 4.46 m): with B = 8.6 m no waterplane of C_WP 0.72 (an earlier estimate) "
+                 "gives a BM_T as small as BC93's (its mesh had BM_T 4.44 m, GM_T 2.61 m), and a wave excitation "
+                 "of a hull 2.4 times stiffer in roll than the restoring it met made the simulated ship heel "
+                 "several times the wave slope in long waves. ship.toml's waterplane area, x_F and GM_L are this "
+                 "mesh's.")
     try:
         import importlib.metadata as im
         versions = {p: im.version(p) for p in ("capytaine", "numpy", "xarray", "h5netcdf")}

@@ -7,7 +7,8 @@ zero-speed, deep-water radiation and excitation coefficients of the parametric h
 mesh (:func:`.build.solve_level`, same axes and phase conventions as the truth database), the design
 rigid-body mass matrix, the design restoring matrix and the fixed linear roll damping. The RAO itself is
 assembled at run time by :mod:`vtrials.reduce.design_rao` (the reductions may not import physics):
-heave, roll and pitch free, the coefficients at the encounter frequency, nothing else for speed.
+sway, heave, roll and pitch free (:data:`FREE_DOFS`), the coefficients at the encounter frequency,
+nothing else for speed.
 
 How the design model differs from the truth (models/<ship>/design/README.md quantifies it with
 ``benchmarks/design_rao_vs_truth.py``):
@@ -16,9 +17,11 @@ How the design model differs from the truth (models/<ship>/design/README.md quan
 * condition: the design KG (preliminary weight estimate) instead of the as-inclined one; radii of
   gyration from design rules of thumb; the stability booklet's KM for the roll stiffness, the coarse
   mesh's own hydrostatics for heave and pitch;
-* roll damping: a fixed fraction of critical at the design roll natural frequency (no viscous model);
-* dynamics: sway and yaw held (strip-theory practice), no forward-speed terms besides the encounter
-  frequency.
+* roll damping: a fixed fraction of critical at the design roll natural frequency, plus Ikeda's hull-lift
+  term per m/s of speed (``roll_damping_speed``; no other viscous model);
+* dynamics: surge and yaw held (the autopilot holds the heading), sway free without restoring and without
+  the maneuvering model's hull forces (strip theory couples sway and roll, Salvesen, Tuck & Faltinsen
+  1970), no forward-speed terms besides the encounter frequency.
 """
 
 from __future__ import annotations
@@ -38,6 +41,15 @@ from vtrials.errors import InputError
 
 from . import build as B
 from . import hullform as hf
+
+#: The design model's free DOFs: sway, heave, roll, pitch (surge and yaw held). Roll needs sway free: on a
+#: small ship the sway–roll inertia coupling m z_G + A24 is large (patrol51's design roll natural
+#: frequency is 1.19 rad/s free to sway, 1.04 rad/s held), and a ship held in sway in long beam waves
+#: does not heel with the wave slope. Yaw free without restoring or autopilot (no heading control in a
+#: frequency-domain model) would wander at low encounter frequency and, through the roll–yaw coupling,
+#: double the long-wave roll (measured on patrol51's design model: 2.0–3.2 × the slope at 0.2–0.3 rad/s
+#: in beam seas, 1.02–1.04 with yaw held).
+FREE_DOFS = (1, 2, 3, 4)
 
 
 def _val(x):
@@ -75,15 +87,33 @@ def design_matrices(setup: B.ShipSetup, doc: dict, res: dict) -> dict:
     C[3, 3] = setup.rho * setup.g * setup.volume * gm_t
     C[3, :3] = C[:3, 3] = 0.0
     zeta = float(_val(m["roll_damping_ratio"]))
-    wn = math.sqrt(C[3, 3] / (M[3, 3] + res["A_inf"][3, 3]))
+    idx = [3, 1]                                  # roll, then the free sway (no restoring)
+
+    def roll_inertia(A):                          # Schur complement: the inertia felt in roll, sway free
+        K = M[np.ix_(idx, idx)] + A[np.ix_(idx, idx)]
+        return float(K[0, 0] - K[0, 1:] @ np.linalg.solve(K[1:, 1:], K[1:, 0]))
+
+    def A_at(w):
+        return np.array([[np.interp(w, setup.omega, res["A"][:, i, j]) for j in range(6)] for i in range(6)])
+
+    wn = math.sqrt(C[3, 3] / roll_inertia(res["A_inf"]))
     for _ in range(50):
-        a44 = float(np.interp(wn, setup.omega, res["A"][:, 3, 3]))
-        wn = math.sqrt(C[3, 3] / (M[3, 3] + a44))
-    a44 = float(np.interp(wn, setup.omega, res["A"][:, 3, 3]))
+        wn = math.sqrt(C[3, 3] / roll_inertia(A_at(wn)))
+    i_eff = roll_inertia(A_at(wn))
     b44_wave = float(np.interp(wn, setup.omega, res["B"][:, 3, 3]))
-    crit = 2.0 * math.sqrt((M[3, 3] + a44) * C[3, 3])
-    return {"M": M, "C": C, "B44_add": max(zeta * crit - b44_wave, 0.0), "omega_roll": wn, "GM_T": gm_t,
-            "B44_wave": b44_wave, "B44_crit": crit}
+    crit = 2.0 * math.sqrt(i_eff * C[3, 3])
+    out = {"M": M, "C": C, "B44_add": max(zeta * crit - b44_wave, 0.0), "omega_roll": wn, "GM_T": gm_t,
+           "B44_wave": b44_wave, "B44_crit": crit, "B44_per_speed": 0.0}
+    if "roll_damping_speed" in m:
+        kind = _val(m["roll_damping_speed"])
+        if kind != "ikeda_lift":
+            raise InputError("design.toml", "model.roll_damping_speed", f"{kind!r}: the only method is 'ikeda_lift'")
+        from vtrials.physics.forces.roll_damping import RollHull, lift
+        hp = setup.particulars
+        h = RollHull(L=hp.length, B=hp.beam, d=hp.draught, C_B=hp.C_B, C_M=hp.C_M,
+                     OG=hp.draught - float(_val(c["KG"])), rho=setup.rho)
+        out["B44_per_speed"] = float(lift(h, 1.0))
+    return out
 
 
 def write_design(path: Path, setup: B.ShipSetup, res: dict, mats: dict, attrs: dict) -> None:
@@ -149,9 +179,10 @@ def build_design(ship: str, models_dir: Path = B.MODELS_DIR, n_threads: int = 2)
         "heading_convention": "direction of wave travel relative to the ship, from +x towards +y (starboard); "
                               "pi = head seas, 0 = following, pi/2 = travelling to starboard (from port)",
         "phase_convention": "eta(t) = Re{a exp(i(omega t - k (x cos b + y sin b)))}; F(t) = Re{X a exp(i omega t)}",
-        "free_dofs": json.dumps([2, 3, 4]),
+        "free_dofs": json.dumps(list(FREE_DOFS)),
         "roll_damping_linear": mats["B44_add"],
         "roll_damping_ratio": float(_val(doc["model"]["roll_damping_ratio"])),
+        "roll_damping_per_speed": mats["B44_per_speed"],
         "roll_natural_frequency": mats["omega_roll"],
         "GM_T": mats["GM_T"],
         "center_of_gravity": json.dumps([float(v) for v in setup.r_G]),

@@ -14,9 +14,9 @@ components) is differentiated by central finite differences of the kernels about
 (Kirchhoff form, Fossen 2011 Thm 3.2, written out again here) are differentiated likewise. Linear
 kinematics about U (Fossen 2011 §7.5): ẏ = v + Uψ, ż = w − Uθ, φ̇ = p, θ̇ = q, ψ̇ = r, so with
 η̂ = (x, y, z, φ, θ, ψ) the body velocities are ν̂ = T η̂, T = iω_e I + U E (E_vψ = −1, E_wθ = +1).
-The radiation memory adds −K̂(ω_e) iω_e (z, φ, θ) with K̂ = B(ω_e) + iω_e (A(ω_e) − A∞) (Ogilvie
-1964) in heave, roll and pitch (its inputs are the world vertical velocity and the roll and pitch
-rates). Quadratic roll damping: harmonic equivalent linearisation B_eq = (8/3π) ω_e φ_a B₂ at the
+The radiation memory adds −K̂(ω_e) ξ̂ with K̂ = B(ω_e) + iω_e (A(ω_e) − A∞) (Ogilvie 1964) over its
+DOFs (sway, heave, roll, pitch), its inputs ξ̂ being the body sway velocity v̂ = iω_e ŷ − U ψ̂, the world
+vertical velocity iω_e ẑ and the roll and pitch rates iω_e φ̂, iω_e θ̂. Quadratic roll damping: harmonic equivalent linearisation B_eq = (8/3π) ω_e φ_a B₂ at the
 response amplitude (iterated). Then
 
     [iω_e (M_RB + M_A) T − J_ν T + C_ν T − J_η + iω_e K̂ + iω_e B_eq] η̂ = X(ω, β) a.
@@ -127,9 +127,19 @@ def coriolis_jacobian(vessel, U: float, eps: float = 1e-4) -> np.ndarray:
     return J
 
 
+def _memory_dofs_of(vessel) -> list[int]:
+    """The DOFs of ``vessel``'s radiation memory component (read from its packed parameters; none if it
+    has no memory)."""
+    for c in vessel.components:
+        if c.type == "radiation":
+            m = int(c.params[1])
+            return [int(d) for d in c.params[2:2 + m]]
+    return []
+
+
 def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_damping=None, amplitude: float = 0.0,
                 iters: int = 30, excitation_dofs=(0, 1, 2, 3, 4, 5), Jd=None, autopilot=None,
-                roll_beq=None) -> np.ndarray:
+                roll_beq=None, memory_dofs=None) -> np.ndarray:
     """Complex RAO (nω, 6) of (x, y, z, φ, θ, ψ) per metre of wave amplitude of the coupled system above.
 
     vessel: the seakeeping vessel (its M_RB and M_A, i.e. A∞ in heave/roll/pitch); Jv, Je, Jc from
@@ -141,7 +151,8 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
     first-order follow-up δ̇ = (δ_c − δ)/T (rate limit not reached), i.e. a rudder force
     J_δ δ̂ with δ̂ = −(K_p + K_i/(iω_e) + K_d iω_e) ψ̂ / (1 + iω_e T).
     ``roll_beq``: a fixed equivalent linear roll damping [N m s] added instead of the harmonic
-    linearisation of B₂ (e.g. the stochastic one for irregular seas)."""
+    linearisation of B₂ (e.g. the stochastic one for irregular seas). ``memory_dofs``: the DOFs of the
+    radiation memory (default: those of the vessel's radiation component)."""
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     we = encounter_frequency(omega, beta, U, db.g)
     A, B = extended_coefficients(db.omega, db.A, db.B, db.A_inf, np.abs(we))
@@ -155,7 +166,8 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
     E = np.zeros((6, 6))
     E[1, 5] = -1.0
     E[2, 4] = 1.0
-    idx = np.ix_((2, 3, 4), (2, 3, 4))
+    mem = list(memory_dofs) if memory_dofs is not None else _memory_dofs_of(vessel)
+    Kh_rows = np.ix_(mem, mem)
     b2 = 0.0 if roll_damping is None else float(roll_damping.B2(U))
     out = np.zeros((omega.size, 6), dtype=complex)
     for n, w in enumerate(we):
@@ -165,7 +177,9 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
             kp, ki, kd, tg = autopilot
             Z[:, 5] += np.asarray(Jd) * (kp + ki / (1j * w) + kd * 1j * w) / (1.0 + 1j * w * tg)
         Kh = B[n] + 1j * w * (A[n] - db.A_inf)
-        Z[idx] += 1j * w * Kh[idx]
+        Tin = 1j * w * np.eye(6)          # the memory's inputs: heave as ż, roll and pitch rates,
+        Tin[1] = T[1]                     # sway as the body sway velocity v = ẏ − Uψ
+        Z[mem] += Kh[Kh_rows] @ Tin[mem]
         if roll_beq is not None:
             Zn = Z.copy()
             Zn[3, 3] += 1j * w * roll_beq

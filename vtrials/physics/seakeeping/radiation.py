@@ -528,8 +528,12 @@ def _select_by_rao(db, dofs, keys, first, cands) -> list:
 
 
 def fit_radiation(db, dofs=(2, 3, 4), max_order: int = MAX_ORDER, couplings: bool = True,
-                  coupling_threshold: float = 0.02, select: str = "rao") -> RadiationModel:
+                  coupling_threshold: float = 0.02, select: str = "rao", extra=()) -> RadiationModel:
     """Fit the radiation memory of database ``db`` (:class:`.database.HydroDatabase`) for ``dofs``.
+
+    ``extra``: further DOFs (e.g. sway, (1,)) whose own pairs and couplings with ``dofs`` are added after
+    the fit of ``dofs``, each by its first admissible fit, leaving the pairs of ``dofs`` exactly as fitted
+    alone (the RAO selection below is made for the seakeeping DOFs; the model's DOFs are the union).
 
     Diagonal pairs are always fitted; an off-diagonal pair (i, j) of :data:`SYMMETRIC_COUPLINGS` is
     fitted when ``couplings`` and max|B_ij| ≥ threshold · sqrt(max B_ii · max B_jj) (else neglected).
@@ -549,6 +553,19 @@ def fit_radiation(db, dofs=(2, 3, 4), max_order: int = MAX_ORDER, couplings: boo
     for d in dofs:
         if d not in range(6):
             raise InputError("radiation", "dofs", f"must be DOF indices 0..5 {DOF_NAMES}, got {dofs!r}")
+    extra = tuple(int(d) for d in extra if int(d) not in dofs)
+    for d in extra:
+        if d not in range(6):
+            raise InputError("radiation", "extra", f"must be DOF indices 0..5 {DOF_NAMES}, got {extra!r}")
+    if extra:
+        base = fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select)
+        h = hashlib.sha1(repr(("extra", dofs, extra, max_order, couplings, coupling_threshold, select)).encode())
+        for arr in (db.omega, db.A, db.B, db.A_inf, db.C, db.mass_matrix, db.X, db.headings):
+            h.update(np.ascontiguousarray(arr).tobytes())
+        key = h.hexdigest()
+        if key not in _FIT_CACHE:
+            _FIT_CACHE[key] = _add_pairs(db, base, extra, max_order, couplings, coupling_threshold)
+        return _FIT_CACHE[key]
     h = hashlib.sha1(repr((dofs, max_order, couplings, coupling_threshold, select)).encode())
     for arr in (db.omega, db.A, db.B, db.A_inf, db.C, db.mass_matrix, db.X, db.headings):
         h.update(np.ascontiguousarray(arr).tobytes())
@@ -563,12 +580,16 @@ def fit_radiation(db, dofs=(2, 3, 4), max_order: int = MAX_ORDER, couplings: boo
 _FIT_CACHE: dict[str, RadiationModel] = {}
 
 
-def _fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select) -> RadiationModel:
+def _pair_keys(db, dofs, couplings, coupling_threshold, new=None):
+    """The DOF pairs (i, j) fitted and each one's band: the diagonal of each DOF, and the couplings of
+    :data:`SYMMETRIC_COUPLINGS` whose damping reaches the threshold; ``new``: only pairs involving these."""
     om = db.omega
     bands = {i: _energetic_band(om, db.B[:, i, i]) for i in dofs}
     keys, pair_band = [], {}
     for i in dofs:
         for j in dofs:
+            if new is not None and i not in new and j not in new:
+                continue
             if i != j:
                 if not couplings or (min(i, j), max(i, j)) not in SYMMETRIC_COUPLINGS:
                     continue
@@ -582,6 +603,27 @@ def _fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select) -
                 band = bands[i]
             keys.append((i, j))
             pair_band[(i, j)] = band
+    return keys, pair_band
+
+
+def _add_pairs(db, base, extra, max_order, couplings, coupling_threshold) -> RadiationModel:
+    dofs = tuple(sorted(set(base.dofs) | set(extra)))
+    keys, pair_band = _pair_keys(db, dofs, couplings, coupling_threshold, new=set(extra))
+    om = db.omega
+    added = []
+    for k in keys:
+        fits = pair_candidates(om, db.A[:, k[0], k[1]], db.B[:, k[0], k[1]], db.A_inf[k], pair_band[k],
+                               max_order, k[0], k[1])
+        good = [f for f in fits if f.r2_kernel >= 0.99]
+        # the most accurate stable fit (not the first admissible): these couplings enter roll in long
+        # waves as the small remainder of two large moments (vtrials.physics.seakeeping.timedomain)
+        added.append(min(good, key=lambda f: max(f.err_A, f.err_B)) if good else _pick(fits, 0.99, 0.05))
+    return _assemble(dofs, list(base.pairs) + added, db)
+
+
+def _fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select) -> RadiationModel:
+    om = db.omega
+    keys, pair_band = _pair_keys(db, dofs, couplings, coupling_threshold)
     first = {k: fit_pair(om, db.A[:, k[0], k[1]], db.B[:, k[0], k[1]], db.A_inf[k], pair_band[k],
                          max_order=max_order, i=k[0], j=k[1]) for k in keys}
     if select == "first":

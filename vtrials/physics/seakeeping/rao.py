@@ -86,18 +86,36 @@ def rao(db, omega, beta: float, U: float = 0.0, dofs=(2, 3, 4), M=None, C=None, 
     return out
 
 
-def natural_frequency(db, dof: int, M=None, C=None, iters: int = 50) -> float:
-    """Undamped natural frequency [rad/s] of one DOF alone: ω_n = sqrt(C_ii / (M_ii + A_ii(ω_n)))
-    (fixed-point iteration on A(ω); e.g. Faltinsen 1990 §3)."""
+def natural_frequency(db, dof: int, M=None, C=None, iters: int = 50, free=()) -> float:
+    """Undamped natural frequency [rad/s] of one DOF: ω_n = sqrt(C_ii / I_eff(ω_n)) (fixed-point
+    iteration on A(ω); e.g. Faltinsen 1990 §3). I_eff = M_ii + A_ii(ω) with the other DOFs held; with
+    ``free`` DOFs (no restoring, free to move with it: e.g. sway (1,) for roll) the Schur complement of
+    the inertia K = M + A(ω) over (dof, free): K_dd − K_df K_ff⁻¹ K_fd, the inertia a ship free to sway
+    feels in roll (its sway–roll inertia coupling m z_G + A24 makes it sway as it rolls)."""
     M = db.mass_matrix if M is None else np.asarray(M, dtype=float)
     C = db.C if C is None else np.asarray(C, dtype=float)
     if not C[dof, dof] > 0.0:
         raise InputError("rao", "dof", f"DOF {dof} has no restoring (C_ii = {C[dof, dof]})")
-    w = math.sqrt(C[dof, dof] / (M[dof, dof] + db.A_inf[dof, dof]))
+    free = [int(f) for f in free]
+    idx = [dof] + free
+
+    def inertia(w):
+        A = np.empty((len(idx), len(idx)))
+        for a_, i in enumerate(idx):
+            for b_, j in enumerate(idx):
+                if w is None:
+                    A[a_, b_] = db.A_inf[i, j]
+                else:
+                    A[a_, b_] = extended_coefficients(db.omega, db.A[:, i, j], db.B[:, i, j], db.A_inf[i, j],
+                                                      np.array([w]))[0][0]
+        K = M[np.ix_(idx, idx)] + A
+        if not free:
+            return float(K[0, 0])
+        return float(K[0, 0] - K[0, 1:] @ np.linalg.solve(K[1:, 1:], K[1:, 0]))
+
+    w = math.sqrt(C[dof, dof] / inertia(None))
     for _ in range(iters):
-        a, _b = extended_coefficients(db.omega, db.A[:, dof, dof], db.B[:, dof, dof],
-                                      db.A_inf[dof, dof], np.array([w]))
-        w_new = math.sqrt(C[dof, dof] / (M[dof, dof] + a[0]))
+        w_new = math.sqrt(C[dof, dof] / inertia(w))
         if abs(w_new - w) < 1e-12 * w:
             return w_new
         w = w_new

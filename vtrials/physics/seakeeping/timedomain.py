@@ -2,9 +2,23 @@
 
 How the two models combine (nothing counted twice):
 
-* Horizontal DOFs (surge, sway, yaw): the maneuvering model (hull, propellers, rudders, its added
-  mass) is kept unchanged. The first-order wave excitation acts on them (unless masked), but no
-  radiation memory: their hydrodynamic reaction stays the maneuvering model's.
+* Surge and yaw: the maneuvering model (hull, propellers, rudders, its added mass) is kept unchanged.
+  The first-order wave excitation acts on them (unless masked), but no radiation memory: their
+  hydrodynamic reaction stays the maneuvering model's.
+* Sway: the maneuvering model's hull forces, but its added mass and its couplings with heave, roll and
+  pitch are the database's A∞, with the radiation memory of sway and of the sway–roll coupling
+  (inputs: the body sway velocity; K̂(0) = 0, so a steady drift angle gets no memory force). Reason:
+  the long-wave limit. In a long beam wave a ship sways with the water and heels with the wave slope
+  only if the wave excitation (whose diffraction part carries the hull's own A22(ω), A42(ω)) meets the
+  same added mass in the dynamics. Measured on patrol51 (stand-in hull fitted to BC93's KM, zero
+  speed, ω 0.2–0.5 rad/s, :func:`.linearize.coupled_rao`): with BC93's Y_v̇ and its antisymmetric
+  sway–roll added mass (Y_ṗ = −K_v̇, where potential flow makes it symmetric) it heeled 2.8–3.4 times
+  the wave slope and swayed 0.91–0.97 of the water; with the database's symmetric A24 but BC93's Y_v̇,
+  1.5–1.7 times and 0.77; with the database's sway added mass and memory, 1.08–1.23 times (the quasi-
+  static 1/(1 − (ω/ω_n)²) with ω_n 1.14 rad/s is 1.03–1.24) and 0.98–1.00 (tests/test_seakeeping_sim.py).
+  The price: in waves the sway added mass at maneuvering frequencies is the stand-in hull's
+  A22(ω → 0) (patrol51 ≈ 3.3e5 kg at 0.2 rad/s against BC93's
+  Y_v̇ 3.93e5 kg), so maneuvers in waves see a slightly lighter ship in sway than in calm water.
 * Heave, roll, pitch (the seakeeping DOFs): the maneuvering model has only the hydrostatic restoring
   and a linear/quadratic damping there. With seakeeping on
   - the added mass of these DOFs (and their couplings among themselves) is the database's A∞ in the
@@ -29,18 +43,13 @@ How the two models combine (nothing counted twice):
   and the body heave velocity is w = ż + Uθ, so the time domain carries a speed coupling
   A∞_i3 U θ̇ (the A∞ part of Salvesen–Tuck–Faltinsen's B35 = B35⁰ + U A33); the matching RAO is
   :func:`.rao.rao` with ``body_axes_added_mass=True`` for heave and pitch in head seas.
-* The frequency-domain reference for this whole coupled system (free sway and yaw under the
-  maneuvering model, its speed-dependent sway–roll–yaw hull terms, autopilot and steering) is
-  :func:`.linearize.coupled_rao`; :func:`.rao.rao` holds the horizontal DOFs, which in beam and
-  oblique seas differs from the simulated ship by 5–9 % in roll at zero speed and 15–31 % at 5 m/s
-  (patrol51). Physically, roll with free sway is what a real ship has; but here the free sway is the
-  maneuvering model's (BC93 Y_v̇, Y_ṗ, K_v̇) while A44(ω) is the database's with sway held, so the
-  simulated roll resonance (patrol51: 0.86 rad/s) is not the database's free-ship one (≈ 1.0–1.1
-  rad/s; hydro/README.md).
-* Restoring stays the ship file's hydrostatics component (not the database mesh's C): for patrol51 the
-  roll stiffness is BC93's GM_T 1.1 m (the roll period and the hull derivatives belong to it), while
-  the meshed stand-in hull has GM_T 2.61 m (models/patrol51/hydro/README.md: a known inconsistency of
-  the stand-in hull's waterplane; the database's roll excitation belongs to the meshed hull).
+* The frequency-domain reference for this whole coupled system (free sway and yaw, the maneuvering
+  model's speed-dependent sway–roll–yaw hull terms, autopilot and steering) is
+  :func:`.linearize.coupled_rao`; :func:`.rao.rao` holds the horizontal DOFs.
+* Restoring stays the ship file's hydrostatics component (not the database mesh's C). The stand-in
+  hull's waterplane should give the ship file's KM, or the wave excitation belongs to a hull of
+  another roll stiffness: patrol51's is fitted to BC93's KM (hull.toml C_WP; mesh KM within 0.1 %),
+  KVLCC2's mesh has GM_T 6.21 m against the ship file's 5.71 m (models/<ship>/hydro/README.md).
 """
 
 from __future__ import annotations
@@ -59,19 +68,28 @@ from vtrials.physics.forces.registry import Component
 from vtrials.physics.seakeeping.radiation import fit_radiation
 
 SEAKEEPING_DOFS = (2, 3, 4)
+#: DOFs of the radiation memory: the seakeeping DOFs and sway (see the module notes: the sway–roll
+#: coupling and the sway added mass in waves are the database's, so that the long-wave limit holds).
+MEMORY_DOFS = (1, 2, 3, 4)
+
+
+def memory_model(db):
+    """The fitted radiation memory (:class:`.radiation.RadiationModel`) the seakeeping vessel uses."""
+    return fit_radiation(db, dofs=SEAKEEPING_DOFS, extra=tuple(d for d in MEMORY_DOFS if d not in SEAKEEPING_DOFS))
 
 
 def roll_damping_of(vessel, db, hull_toml=None):
     """The viscous roll damping (:class:`vtrials.physics.forces.roll_damping.RollDamping`) the seakeeping
     vessel gets, from the ``[roll_damping]`` table of ``hull_toml`` (default: ``hull.toml`` next to the
     database). Its frequency-dependent parts are taken at the natural roll frequency of the vessel's
-    mass and restoring with the database's A44(ω) (:func:`.rao.natural_frequency`)."""
+    mass and restoring with the database's added mass, free to sway as the simulated ship is
+    (:func:`.rao.natural_frequency` with ``free=(1,)``)."""
     from vtrials.physics.seakeeping.hullform import hull_particulars_from_table
     from vtrials.physics.seakeeping.rao import natural_frequency
     from vtrials.schema import load_toml
     path = Path(hull_toml) if hull_toml is not None else Path(db.attrs["_path"]).parent / "hull.toml"
     tab = rd_mod.read_roll_damping_table(path)
-    wn = natural_frequency(db, 3, M=vessel.M_RB, C=vessel.restoring_matrix())
+    wn = natural_frequency(db, 3, M=vessel.M_RB, C=vessel.restoring_matrix(), free=(1,))
     if tab.method == "ikeda":
         hp = hull_particulars_from_table(load_toml(path)["hull"], str(path))
         P = vessel.particulars
@@ -113,11 +131,19 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
             raise InputError("seakeeping_vessel", "roll_damping", f"expected 'model', a RollDamping or None, got {roll_damping!r}")
         roll_damping = roll_damping_of(vessel, db)
     if model is None:
-        model = fit_radiation(db, dofs=SEAKEEPING_DOFS)
+        model = memory_model(db)
+    if tuple(model.dofs) != MEMORY_DOFS:
+        raise InputError("seakeeping_vessel", "model", f"the radiation memory must cover the DOFs {MEMORY_DOFS} "
+                         f"(timedomain.memory_model), got {tuple(model.dofs)}")
     v = copy.copy(vessel)
     M_A = vessel.M_A.copy()
     idx = np.ix_(SEAKEEPING_DOFS, SEAKEEPING_DOFS)
     M_A[idx] = db.A_inf[idx]
+    # sway: its added mass and its couplings with heave, roll and pitch are the database's A∞ (the memory
+    # adds A(ω) − A∞); its couplings with surge and yaw stay the maneuvering model's
+    for j in MEMORY_DOFS:
+        M_A[1, j] = db.A_inf[1, j]
+        M_A[j, 1] = db.A_inf[j, 1]
     v.M_A = M_A
     comps = []
     for c in vessel.components:
@@ -146,4 +172,4 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
     return v, model
 
 
-__all__ = ["seakeeping_vessel", "roll_damping_of", "hydrostatics"]
+__all__ = ["seakeeping_vessel", "roll_damping_of", "memory_model", "hydrostatics", "MEMORY_DOFS"]
