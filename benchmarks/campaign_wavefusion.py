@@ -143,7 +143,8 @@ def reduce_case(out: Path, scn, design, legs=LEGS) -> list[dict]:
             row["buoy"] = {"hs_err": rb.fit.hs / st["hs"] - 1.0, "from_rel_deg": rb.from_relative_deg, "dir_err_deg": d,
                            "side_right": bool(abs(st["from_rel_deg"]) < 10.0 or abs(st["from_rel_deg"]) > 170.0
                                               or np.sign(rb.from_relative_deg) == np.sign(st["from_rel_deg"])),
-                           "tp": rb.fit.tp, "s": rb.fit.s, "gamma": rb.fit.gamma}
+                           "tp": rb.fit.tp, "s": rb.fit.s, "gamma": rb.fit.gamma,
+                           "observed": list(rb.observed), "reliable": rb.reliable}
         except Exception as exc:  # reported, not hidden
             row["buoy"] = {"error": f"{type(exc).__name__}: {exc}"[:200]}
         rows.append(row)
@@ -171,14 +172,18 @@ def _summary(rows) -> dict:
         out["combos"][c] = {"mean": float(np.mean(f)), "std": sd, "scatter_reduction": out["radar_ratio_std"] / sd,
                             "within_15pct_above_2.5m": int(np.sum((np.abs(f - 1) <= 0.15) & (hs > 2.5))),
                             "within_15pct_all": int(np.sum(np.abs(f - 1) <= 0.15))}
-    b = [r["buoy"] for r in rows if "hs_err" in r.get("buoy", {})]
-    if b:
+    b_all = [r["buoy"] for r in rows if "hs_err" in r.get("buoy", {})]
+    for key, b in (("ship_buoy", b_all), ("ship_buoy_reliable", [x for x in b_all if x.get("reliable")]),
+                   ("ship_buoy_flagged", [x for x in b_all if not x.get("reliable", True)])):
+        if not b:
+            continue
         he = np.array([x["hs_err"] for x in b])
         de = np.array([abs(x["dir_err_deg"]) for x in b])
-        out["ship_buoy"] = {"n": len(b), "hs_within_15pct": int(np.sum(np.abs(he) <= 0.15)),
-                            "dir_within_15deg": int(np.sum(de <= 15.0)), "side_right": int(sum(x["side_right"] for x in b)),
-                            "hs_err_mean": float(np.mean(he)), "hs_abs_err_median": float(np.median(np.abs(he))),
-                            "dir_abs_err_median_deg": float(np.median(de))}
+        out[key] = {"n": len(b), "hs_within_15pct": int(np.sum(np.abs(he) <= 0.15)),
+                    "dir_within_15deg": int(np.sum(de <= 15.0)), "side_right": int(sum(x["side_right"] for x in b)),
+                    "both": int(np.sum((np.abs(he) <= 0.15) & (de <= 15.0))),
+                    "hs_err_mean": float(np.mean(he)), "hs_abs_err_median": float(np.median(np.abs(he))),
+                    "dir_abs_err_median_deg": float(np.median(de))}
     return out
 
 

@@ -72,6 +72,7 @@ def score_case(out: Path, scn, design, settings=SETTINGS) -> list[dict]:
             row[name] = {"hs": rb.fit.hs, "hs_err": rb.fit.hs / st["hs"] - 1.0, "from_rel_deg": rb.from_relative_deg,
                          "dir_err_deg": math.degrees(d), "tp": rb.fit.tp, "s": rb.fit.s, "gamma": rb.fit.gamma,
                          "gains": list(rb.fit.gains), "U_log": rb.U,
+                         "observed": list(rb.observed), "reliable": rb.reliable,
                          "side_right": bool(np.sign(rb.from_relative_deg) == np.sign(st["from_rel_deg"])),
                          "seconds": time.perf_counter() - t}
         rows.append(row)
@@ -82,13 +83,19 @@ def score_case(out: Path, scn, design, settings=SETTINGS) -> list[dict]:
 def summary(rows, settings=SETTINGS) -> dict:
     out = {}
     for name in settings:
-        he = np.array([abs(r[name]["hs_err"]) for r in rows])
-        de = np.array([abs(r[name]["dir_err_deg"]) for r in rows])
-        side = np.array([r[name]["side_right"] for r in rows])
-        out[name] = {"n": len(rows), "hs_within_15pct": int(np.sum(he <= 0.15)), "dir_within_15deg": int(np.sum(de <= 15.0)),
-                     "both": int(np.sum((he <= 0.15) & (de <= 15.0))), "side_right": int(np.sum(side)),
-                     "hs_abs_err_median": float(np.median(he)), "hs_err_mean": float(np.mean([r[name]["hs_err"] for r in rows])),
-                     "dir_abs_err_median_deg": float(np.median(de)), "dir_abs_err_max_deg": float(np.max(de))}
+        for tag, sel in (("", rows), ("_reliable", [r for r in rows if r[name].get("reliable")]),
+                         ("_flagged", [r for r in rows if not r[name].get("reliable", True)])):
+            if not sel:
+                continue
+            he = np.array([abs(r[name]["hs_err"]) for r in sel])
+            de = np.array([abs(r[name]["dir_err_deg"]) for r in sel])
+            side = np.array([r[name]["side_right"] for r in sel])
+            out[name + tag] = {"n": len(sel), "hs_within_15pct": int(np.sum(he <= 0.15)),
+                               "dir_within_15deg": int(np.sum(de <= 15.0)),
+                               "both": int(np.sum((he <= 0.15) & (de <= 15.0))), "side_right": int(np.sum(side)),
+                               "hs_abs_err_median": float(np.median(he)),
+                               "hs_err_mean": float(np.mean([r[name]["hs_err"] for r in sel])),
+                               "dir_abs_err_median_deg": float(np.median(de)), "dir_abs_err_max_deg": float(np.max(de))}
     return out
 
 

@@ -49,3 +49,33 @@ def test_ship_as_wave_buoy(rel_from_deg):
           f"T_p {fit.tp:.2f} vs 9.00 s, direction error {dmu:.1f}°, s {fit.s:.1f} vs 10")
     assert fit.hs == pytest.approx(field.hs_realized_m, rel=0.15)
     assert dmu < 15.0  # port and starboard told apart: a mirror image would be off by 2|rel| ≥ 60°
+
+
+def test_observed_fraction_flags_folded_following_seas():
+    """The in-band fraction of a fitted sea's responses (what :attr:`RecordBuoy.reliable` tests), against
+    the same sums done directly: the encounter frequency of every (ω, μ) cell. Head seas at 9 m/s put all
+    the response above 0.2 rad/s (fraction 1); in following seas at 9 m/s waves of 0.83–1.30 rad/s meet
+    the ship below 0.2 rad/s (|ω − ω²U/g| < 0.2), which holds most of a T_p 6-s sea."""
+    from vtrials.reduce.shipbuoy import OBSERVED_MIN, ShipBuoyFit, cos2s, jonswap, observed_fraction
+    U, de = 9.0, 2.0 * math.pi / 128.0
+    omega = np.linspace(0.2, 2.5, 200)
+    mu = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+    W, M = np.meshgrid(omega, mu, indexing="ij")
+    rao = SHIP.rao(W, M, U)
+    bins = de * np.arange(int(2.0 / de) + 1)
+    band = bins >= 0.2
+    model, full = ResponseModel(omega, mu, rao, U, bins[band]), ResponseModel(omega, mu, rao, U, bins)
+    we = np.abs(W - W * W * U * np.cos(M) / 9.80665)
+    cell = np.gradient(omega)[:, None] * (2 * math.pi / mu.size)
+    for mu0, tp, expect_reliable in ((math.pi, 8.0, True), (0.0, 8.0, True), (0.0, 6.0, False)):
+        fit = ShipBuoyFit(2.0, tp, mu0, 10.0, 0.0, None)
+        got = observed_fraction(model, full, fit)
+        E = jonswap(omega, 2.0, tp)[:, None] * cos2s(M - mu0, 10.0) * cell
+        k = np.rint(we / de)
+        inside = (k >= np.argmax(band)) & (k <= bins.size - 1)
+        for r in range(rao.shape[0]):
+            a = np.abs(rao[r]) ** 2 * E
+            direct = a[inside].sum() / a[k <= bins.size - 1].sum()
+            assert got[r] == pytest.approx(direct, rel=0.02), (mu0, r, got[r], direct)
+        print(f"mu0 {math.degrees(mu0):.0f}°, T_p {tp} s: observed fractions {np.round(got, 3)}")
+        assert (min(got) >= OBSERVED_MIN) == expect_reliable

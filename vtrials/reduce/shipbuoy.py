@@ -191,6 +191,19 @@ def fit_directional_spectrum(model: ResponseModel, G_meas, starts: int = 8, hs0:
     return ShipBuoyFit(hs, tp, mu0, s, float(best.cost), Gp, gamma, tuple(float(v) for v in g))
 
 
+#: Smallest fraction of each fitted response's variance that must lie inside the fitted encounter band
+#: for the run's result to count as reliable (:attr:`RecordBuoy.reliable`).
+OBSERVED_MIN = 0.8
+
+
+def observed_fraction(model: "ResponseModel", full: "ResponseModel", fit: ShipBuoyFit) -> tuple:
+    """Per response: the fitted sea's response variance on ``model``'s bins ÷ that on ``full``'s bins (the
+    same bins from 0 up to the band's upper edge)."""
+    a = np.real(np.diagonal(model.cross_spectra(fit.hs, fit.tp, fit.mu0, fit.s, fit.gamma), axis1=1, axis2=2))
+    b = np.real(np.diagonal(full.cross_spectra(fit.hs, fit.tp, fit.mu0, fit.s, fit.gamma), axis1=1, axis2=2))
+    return tuple(float(x) for x in a.sum(axis=0) / np.maximum(b.sum(axis=0), 1e-300))
+
+
 @dataclasses.dataclass(frozen=True)
 class RecordBuoy:
     """Ship-as-a-wave-buoy result of one run: the fit, the ship's mean heading and speed, the components."""
@@ -200,6 +213,16 @@ class RecordBuoy:
     U: float
     components: tuple
     duration_s: float
+    observed: tuple = ()          # per component: fraction of the fitted sea's response inside the band
+    min_observed: float = OBSERVED_MIN
+
+    @property
+    def reliable(self) -> bool:
+        """Whether the fit saw most of the responses it explains (every component's in-band fraction ≥
+        ``min_observed``). Where the encounter frequencies fold (following seas at speed) much of the
+        response lies below the band's lower edge, where the motions are high-passed away, and H_s is
+        extrapolated from the spectrum's tail (Nielsen 2006 notes the same limit)."""
+        return bool(self.observed) and min(self.observed) >= self.min_observed
 
     @property
     def from_relative_deg(self) -> float:
@@ -217,7 +240,8 @@ def ship_buoy_from_record(record, t0: float, t1: float, design, components=("hea
     :class:`vtrials.reduce.design_rao.DesignRAO`) at the run's mean log speed on a 0.2–2.5 rad/s × 5° grid.
     γ is fitted (``fit_gamma``) and every RAO trusted in size by default (``free_gain`` names components
     given a free scale): on simulator records (benchmarks/shipbuoy_sim.py, 16 runs) a free roll gain gave
-    no better H_s and worse directions.
+    no better H_s and worse directions. The result carries each component's observed fraction (the fitted
+    sea's response inside the band ÷ from 0 to the band's top) and :attr:`RecordBuoy.reliable`.
     """
     from vtrials.reduce.seamotion import design_responses, run_motions
     from vtrials.reduce.spectra import cross_spectral_matrix
@@ -229,9 +253,11 @@ def ship_buoy_from_record(record, t0: float, t1: float, design, components=("hea
     omega = np.linspace(0.2, 2.5, 200)
     mu = np.linspace(-math.pi, math.pi, 72, endpoint=False)
     W, M = np.meshgrid(omega, mu, indexing="ij")
-    model = ResponseModel(omega, mu, design_responses(design, components, W, M, mot.U, mot.site), mot.U,
-                          G_.omega[keep])
+    rao = design_responses(design, components, W, M, mot.U, mot.site)
+    model = ResponseModel(omega, mu, rao, mot.U, G_.omega[keep])
     hs0 = 4.0 * float(np.std(mot.heave)) if "heave" in components else 2.0
     fit = fit_directional_spectrum(model, G_.S[keep], starts=starts, hs0=max(hs0, 0.2), fit_gamma=fit_gamma,
                                    free_gain=[components.index(c) for c in free_gain if c in components])
-    return RecordBuoy(fit, mot.heading, mot.U, tuple(components), float(mot.t[-1] - mot.t[0]))
+    full = ResponseModel(omega, mu, rao, mot.U, G_.omega[G_.omega <= band[1]])
+    return RecordBuoy(fit, mot.heading, mot.U, tuple(components), float(mot.t[-1] - mot.t[0]),
+                      observed_fraction(model, full, fit))
