@@ -88,7 +88,7 @@ def _seeds(text: str) -> list[int]:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", default="2002-2011")
-    ap.add_argument("--run-s", type=float, default=None, help="override the runs' length [s] (180 in the file)")
+    ap.add_argument("--run-s", type=float, default=None, help="override the runs' length [s] (the file's run_s by default)")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "sea_trials_seeds.json"))
     a = ap.parse_args(argv)
     rows = []
@@ -97,7 +97,8 @@ def main(argv=None) -> None:
         sp = rows[-1]["spots"]
         print(f"seed {s}: slow raw {sp[0]['raw']:+.4f} cor {sp[0]['cor']:+.4f}, fast raw {sp[1]['raw']:+.4f} "
               f"cor {sp[1]['cor']:+.4f}", flush=True)
-    out = {"scenario": str(SHORT.relative_to(ROOT)), "run_s": a.run_s or 180.0, "rows": rows, "summary": summary(rows)}
+    file_run_s = float(re.search(r"(?m)^run_s = ([0-9.]+)", SHORT.read_text()).group(1))
+    out = {"scenario": str(SHORT.relative_to(ROOT)), "run_s": a.run_s or file_run_s, "rows": rows, "summary": summary(rows)}
     Path(a.out).write_text(json.dumps(out, indent=1))
     print(json.dumps(out["summary"], indent=1))
 
