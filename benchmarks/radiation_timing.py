@@ -13,7 +13,8 @@ independent reference:
    position, and the body-axis A∞ and its Coriolis term). Reported: the speed loss and every
    component's mean force along the horizontal heading (world frame; the A∞ inertia of the exact
    solve is not a component and is in the loss only).
-2. Roll, heave and pitch at the roll resonance (beam seas, ω 0.86 rad/s, zero speed, 2 mm waves)
+2. Roll, heave and pitch at the roll resonance (beam seas, ω 1.14 rad/s since the roll fix of stop 33 —
+   0.86 rad/s before, with the earlier stand-in hull and BC93's sway added mass —, zero speed, 2 mm waves)
    against the frequency-domain RAO of the same coupled system (:func:`vtrials.physics.seakeeping.
    linearize.coupled_rao`, as tests/test_seakeeping_sim.py) at dt 0.05 (the scenarios' step), 0.02 and
    0.01 s: the ratio of the simulated to the reference amplitude.
@@ -24,7 +25,7 @@ independent reference:
 
 Run: ``python benchmarks/radiation_timing.py [--out FILE]``; results in
 benchmarks/results/radiation_timing.json (and radiation_timing_before.json: the same script with the
-kernel of main before the change).
+kernel of main before the change); radiation_timing_consistent_roll.json: rerun after the roll fix.
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def mean_surge(ves, db, model, U0: float, omega: float, beta_deg: float, dt: flo
             "mean_forward_force_N": fwd}
 
 
-def resonance(ves, db, model, rd, dt: float, omega: float = 0.86, beta_deg: float = 90.0, amp: float = 0.002,
+def resonance(ves, db, model, rd, dt: float, omega: float = 1.14, beta_deg: float = 90.0, amp: float = 0.002,
               t_end: float = 400.0) -> dict:
     beta = math.radians(beta_deg)
     start = ShipState(shaft_rps=(0.0,) * len(ves.shafts))
