@@ -559,19 +559,20 @@ def fit_radiation(db, dofs=(2, 3, 4), max_order: int = MAX_ORDER, couplings: boo
             raise InputError("radiation", "extra", f"must be DOF indices 0..5 {DOF_NAMES}, got {extra!r}")
     if extra:
         base = fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select)
-        h = hashlib.sha1(repr(("extra", dofs, extra, max_order, couplings, coupling_threshold, select)).encode())
-        for arr in (db.omega, db.A, db.B, db.A_inf, db.C, db.mass_matrix, db.X, db.headings):
-            h.update(np.ascontiguousarray(arr).tobytes())
-        key = h.hexdigest()
-        if key not in _FIT_CACHE:
-            _FIT_CACHE[key] = _add_pairs(db, base, extra, max_order, couplings, coupling_threshold)
-        return _FIT_CACHE[key]
-    h = hashlib.sha1(repr((dofs, max_order, couplings, coupling_threshold, select)).encode())
+        return _cached(db, ("extra", dofs, extra, max_order, couplings, coupling_threshold, select),
+                       lambda: _add_pairs(db, base, extra, max_order, couplings, coupling_threshold))
+    return _cached(db, (dofs, max_order, couplings, coupling_threshold, select),
+                   lambda: _fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select))
+
+
+def _cached(db, args, fit):
+    """``fit()``'s model, kept under a digest of the database's arrays and ``args``."""
+    h = hashlib.sha1(repr(args).encode())
     for arr in (db.omega, db.A, db.B, db.A_inf, db.C, db.mass_matrix, db.X, db.headings):
         h.update(np.ascontiguousarray(arr).tobytes())
     key = h.hexdigest()
     if key not in _FIT_CACHE:
-        _FIT_CACHE[key] = _fit_radiation(db, dofs, max_order, couplings, coupling_threshold, select)
+        _FIT_CACHE[key] = fit()
     return _FIT_CACHE[key]
 
 
