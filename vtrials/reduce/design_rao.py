@@ -9,11 +9,12 @@ e.g. Ikeda's hull lift) and nothing more (e.g. Lloyd 1989, "Seakeeping", §§ 5,
 
     [−ω_e² (M + A(|ω_e|)) + iω_e (B(|ω_e|) + B_44 + U B_44,U) + C] ξ̂ = X(ω, μ),   ω_e = ω − ω² U cos μ / g,
 
-for ξ over the file's free DOFs (``free_dofs``: sway, heave, roll, pitch and yaw in the current files, as
-strip theory couples them, Salvesen, Tuck & Faltinsen 1970; heave, roll and pitch alone in older ones),
-surge held, sway and yaw without restoring; the RAOs returned are heave (z down), roll φ and pitch θ at
-the body origin O. Where |ω_e| < :data:`OMEGA_E_FREE` (following seas near ω_e = 0) sway and yaw, which
-have no restoring, are held instead (their response is undefined there); e^{+iω_e t},
+for ξ over the file's free DOFs (``free_dofs``: sway, heave, roll and pitch in the current files, sway
+coupled with roll as strip theory has it, Salvesen, Tuck & Faltinsen 1970; heave, roll and pitch alone in
+older ones; yaw may be listed too), the others held, sway and yaw without restoring; the RAOs returned are
+heave (z down), roll φ and pitch θ at the body origin O. Where |ω_e| < :data:`OMEGA_E_FREE` (following
+seas near ω_e = 0) sway and yaw, which have no restoring, are held instead (their response is undefined
+there); e^{+iω_e t},
 crest at O at t = 0 (the file's convention). μ is the direction the waves travel relative to the
 heading (0 following, π head seas, +π/2 travelling to starboard); the file stores 0 ≤ μ ≤ π and the
 other side follows by port–starboard symmetry (roll changes sign). Outside the file's frequencies:

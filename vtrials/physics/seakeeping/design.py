@@ -41,6 +41,7 @@ from vtrials.errors import InputError
 
 from . import build as B
 from . import hullform as hf
+from .rao import effective_inertia
 
 #: The design model's free DOFs: sway, heave, roll, pitch (surge and yaw held). Roll needs sway free: on a
 #: small ship the sway–roll inertia coupling m z_G + A24 is large (patrol51's design roll natural
@@ -89,9 +90,8 @@ def design_matrices(setup: B.ShipSetup, doc: dict, res: dict) -> dict:
     zeta = float(_val(m["roll_damping_ratio"]))
     idx = [3, 1]                                  # roll, then the free sway (no restoring)
 
-    def roll_inertia(A):                          # Schur complement: the inertia felt in roll, sway free
-        K = M[np.ix_(idx, idx)] + A[np.ix_(idx, idx)]
-        return float(K[0, 0] - K[0, 1:] @ np.linalg.solve(K[1:, 1:], K[1:, 0]))
+    def roll_inertia(A):                          # the inertia felt in roll, sway free
+        return effective_inertia(M[np.ix_(idx, idx)] + A[np.ix_(idx, idx)])
 
     def A_at(w):
         return np.array([[np.interp(w, setup.omega, res["A"][:, i, j]) for j in range(6)] for i in range(6)])

@@ -86,6 +86,15 @@ def rao(db, omega, beta: float, U: float = 0.0, dofs=(2, 3, 4), M=None, C=None, 
     return out
 
 
+def effective_inertia(K: np.ndarray) -> float:
+    """Inertia felt by the first DOF of the inertia block ``K`` (that DOF, then DOFs free to follow it
+    without restoring): the Schur complement K₀₀ − K₀ᵣ K_rr⁻¹ K_r0 (K₀₀ when K is 1 × 1)."""
+    K = np.atleast_2d(np.asarray(K, dtype=float))
+    if K.shape[0] == 1:
+        return float(K[0, 0])
+    return float(K[0, 0] - K[0, 1:] @ np.linalg.solve(K[1:, 1:], K[1:, 0]))
+
+
 def natural_frequency(db, dof: int, M=None, C=None, iters: int = 50, free=()) -> float:
     """Undamped natural frequency [rad/s] of one DOF: ω_n = sqrt(C_ii / I_eff(ω_n)) (fixed-point
     iteration on A(ω); e.g. Faltinsen 1990 §3). I_eff = M_ii + A_ii(ω) with the other DOFs held; with
@@ -108,10 +117,7 @@ def natural_frequency(db, dof: int, M=None, C=None, iters: int = 50, free=()) ->
                 else:
                     A[a_, b_] = extended_coefficients(db.omega, db.A[:, i, j], db.B[:, i, j], db.A_inf[i, j],
                                                       np.array([w]))[0][0]
-        K = M[np.ix_(idx, idx)] + A
-        if not free:
-            return float(K[0, 0])
-        return float(K[0, 0] - K[0, 1:] @ np.linalg.solve(K[1:, 1:], K[1:, 0]))
+        return effective_inertia(M[np.ix_(idx, idx)] + A)
 
     w = math.sqrt(C[dof, dof] / inertia(None))
     for _ in range(iters):
