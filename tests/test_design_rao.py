@@ -100,3 +100,30 @@ def test_design_differs_from_truth_but_not_wildly(design):
 def test_missing_file_is_named(tmp_path):
     with pytest.raises(InputError, match="not found"):
         DesignRAO(tmp_path / "nothing.nc")
+
+
+def test_roll_receptance_is_the_roll_of_a_changed_design(design):
+    """The ship-as-buoy fit changes the design's roll stiffness and damping through the roll receptance
+    h_φ (Sherman–Morrison, vtrials.reduce.shipbuoy): checked against the design re-solved with C₄₄ and
+    B₄₄ changed in its matrices, at zero speed and at 9 m/s, in head, bow, beam and quartering seas;
+    heave and pitch do not change (uncoupled from roll by symmetry)."""
+    c44, bcrit = design.roll_scales
+    assert c44 > 0.0 and bcrit > 0.0
+    w = np.linspace(0.25, 2.4, 40)
+    for U in (0.0, 9.0):
+        for mu in (math.pi, 2.4, math.pi / 2, 0.7):
+            R = design.rao(w, mu, U)
+            h = design.roll_receptance(w, mu, U)
+            for kc, kb in ((-0.25, 0.04), (0.3, -0.03)):
+                other = DesignRAO(design.path)
+                r = other._out[1]
+                other.C[r, r] += kc * c44
+                other.B44 += kb * bcrit
+                R2 = other.rao(w, mu, U)
+                we = w - w * w * U * math.cos(mu) / G
+                q = 1.0 / (1.0 + (kc * c44 + 1j * we * kb * bcrit) * h)
+                np.testing.assert_allclose(R2[1], R[1] * q, rtol=1e-9, atol=1e-14)
+                np.testing.assert_allclose(R2[[0, 2]], R[[0, 2]], rtol=1e-9, atol=1e-14)
+    # the design's own damping at speed, in the same units: the fixed ratio plus the hull-lift term
+    assert design.roll_damping_ratio(0.0) == pytest.approx(float(design.attrs["roll_damping_ratio"]))
+    assert design.roll_damping_ratio(9.0) > design.roll_damping_ratio(0.0)

@@ -16,6 +16,7 @@ import pytest
 from synthetic_ship import SyntheticShip, responses
 
 from vtrials.physics.environment.waves import Waves, realize
+from vtrials.errors import InputError
 from vtrials.reduce.shipbuoy import ResponseModel, fit_directional_spectrum
 from vtrials.reduce.spectra import cross_spectral_matrix
 
@@ -79,3 +80,63 @@ def test_observed_fraction_flags_folded_following_seas():
             assert got[r] == pytest.approx(direct, rel=0.02), (mu0, r, got[r], direct)
         print(f"mu0 {math.degrees(mu0):.0f}°, T_p {tp} s: observed fractions {np.round(got, 3)}")
         assert (min(got) >= OBSERVED_MIN) == expect_reliable
+
+
+class _RetunedRoll:
+    """The synthetic ship with its roll stiffness and damping changed by (κ_C, κ_B) in the units of the fit
+    (C₄₄ = 1, B_crit = 2/ω_n): written out from the single-DOF roll, 1/(1 + κ_C − x² + 2i(ζ + κ_B)x)
+    against 1/(1 − x² + 2iζx), x = ω_e/ω_n, with the same wave moment."""
+
+    def __init__(self, ship, kc, kb):
+        self.ship, self.kc, self.kb = ship, kc, kb
+
+    def rao(self, omega, mu, U):
+        R = self.ship.rao(omega, mu, U)
+        w = np.asarray(omega, dtype=float)
+        x = (w - w * w * U * np.cos(mu) / 9.80665) / self.ship.w4
+        old = 1.0 - x * x + 2j * self.ship.z4 * x
+        new = 1.0 + self.kc - x * x + 2j * (self.ship.z4 + self.kb) * x
+        R[2] = R[2] * old / new
+        return R
+
+
+def test_roll_tuning_recovers_a_mistuned_roll():
+    """The team's roll model is 25 % too stiff and its damping 6 % of critical too low (the true ship:
+    κ_C = −0.2, κ_B = +0.06 from the model). Waves from the starboard bow at 6 m/s put the roll
+    resonance in the band. With roll tuning the fit finds the sea (H_s within 15 % as in the test above,
+    direction within 10°) and the roll changes (κ_C within 0.05, κ_B within 0.02). Measured: H_s −8.7 %,
+    2.2°, (−0.178, 0.060); untuned −12 %, 3.0°."""
+    rng = np.random.default_rng(7)
+    heading = math.radians(40.0)
+    true_ship = _RetunedRoll(SHIP, -0.2, 0.06)
+    field = realize(Waves(hs_m=3.0, tp_s=9.0, direction_deg=(40.0 + 40.0) % 360.0, spreading_s=10.0,
+                          n_components=400), math.inf, rng)
+    t = np.arange(0.0, 1500.0, 1.0 / FS)
+    rec = responses(true_ship, field.components, heading, U, t)
+    rec = rec + 0.02 * rec.std(axis=1, keepdims=True) * rng.standard_normal(rec.shape)
+    G = cross_spectral_matrix(rec, FS, 256)
+    band = (G.omega >= 0.15) & (G.omega <= 2.0)
+    omega = np.linspace(0.2, 2.5, 200)
+    mu = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+    W, M = np.meshgrid(omega, mu, indexing="ij")
+    R = SHIP.rao(W, M, U)
+    part = np.zeros_like(R)
+    part[2] = R[2]
+    x = (W - W * W * U * np.cos(M) / 9.80665) / SHIP.w4
+    h = 1.0 / (1.0 - x * x + 2j * SHIP.z4 * x)          # receptance with C₄₄ = 1
+    mu_true, _ = field.bulk_direction()
+    rel_true = math.remainder(mu_true - heading, 2 * math.pi)
+    errs = {}
+    for tune in (False, True):
+        kw = dict(roll_part=part, roll_receptance=h, roll_scales=(1.0, 2.0 / SHIP.w4)) if tune else {}
+        model = ResponseModel(omega, mu, R, U, G.omega[band], **kw)
+        fit = fit_directional_spectrum(model, G.S[band], tune_roll=tune, roll_damping_min=-0.08)
+        dmu = math.degrees(abs(math.remainder(fit.mu0 - rel_true, 2 * math.pi)))
+        errs[tune] = (fit.hs / field.hs_realized_m - 1.0, dmu)
+        print(f"roll tuned {tune}: H_s {fit.hs:.2f} vs {field.hs_realized_m:.2f} m, direction error {dmu:.1f}°, "
+              f"roll changes {np.round(fit.roll, 3)} vs (-0.2, 0.06)")
+    assert abs(errs[True][0]) < 0.15 and errs[True][1] < 10.0
+    assert fit.roll[0] == pytest.approx(-0.2, abs=0.05)
+    assert fit.roll[1] == pytest.approx(0.06, abs=0.02)
+    with pytest.raises(InputError, match="roll part"):
+        fit_directional_spectrum(ResponseModel(omega, mu, R, U, G.omega[band]), G.S[band], tune_roll=True)

@@ -13,13 +13,13 @@ truth on those seeds before the change, 1.24, 1.09, 1.43, 1.30 after: a coin tos
 At 9 m/s (seeds 4322–4325): heading standard deviation 1.7–5.5°, fused H_s 1.050, 1.025, 1.022, 1.055 ×
 the truth before, 1.093, 1.029, 1.028, 1.058 after.
 
-* ship as a wave buoy: H_s within 15 %, mean direction within 15°, port/starboard right (16 runs in
-  benchmarks/results/shipbuoy_sim.json: directions 16/16 within 13°, sides 16/16; H_s 9/16 within 15 %,
-  bow seas under-read by 13–24 % from the design model's heave/roll errors; 52 star legs at 9 m/s in
-  campaign_wavefusion.json: sides 52/52, directions 35/52 within 15°, H_s 33/52 within 15 %);
+* ship as a wave buoy: H_s within 15 %, mean direction within 15°, port/starboard right, with the design
+  roll tuned with the sea (benchmarks/results/shipbuoy_sim.json, 14 reliable runs of 10 min: directions
+  12/14, H_s 9/14, sides 12/14; 48 reliable star legs in campaign_wavefusion.json: directions 42/48,
+  H_s 44/48, sides 45/48);
 * wave fusion (seed 004 eqs. 1–5) with heave + pitch takes out the radar's calibration error: fused H_s
-  within 15 % while the radar is more than 25 % off (campaign of 52 25-min legs over H_s 1.5–5 m in
-  benchmarks/results/campaign_wavefusion.json: radar/true std 0.252 → 0.073 fused, 27/28 within ±15 %
+  within 15 % while the radar is more than 25 % off (campaign of 64 25-min legs over H_s 1.5–5 m in
+  benchmarks/results/campaign_wavefusion.json: radar/true std 0.245 → 0.059 fused, 37/40 within ±15 %
   above 2.5 m).
 """
 

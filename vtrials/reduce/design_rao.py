@@ -125,11 +125,8 @@ class DesignRAO:
         mirror = np.where(sgn[..., None] < 0.0, self._mirror, 1.0)
         return x * mirror
 
-    def rao(self, omega, mu, U: float) -> np.ndarray:
-        """Complex RAOs (3, …) of heave (z down) [m/m], roll [rad/m], pitch [rad/m] at O (module doc).
-
-        omega [rad/s] > 0 and mu [rad] broadcast together; U [m/s] ≥ 0.
-        """
+    def _system(self, omega, mu, U: float):
+        """(Z (n, k, k), X (n, k), ω_e (n,), shape) of the free DOFs at the flattened (ω, μ) (module doc)."""
         if not (math.isfinite(U) and U >= 0.0):
             raise InputError("record", "U", f"ship speed {U!r} m/s: must be a finite number ≥ 0")
         w, m = np.broadcast_arrays(np.asarray(omega, dtype=float), np.asarray(mu, dtype=float))
@@ -156,8 +153,40 @@ class DesignRAO:
             Xh = X[held]
             Xh[:, h] = 0.0
             X[held] = Xh
+        return Z, X, we, shape
+
+    def rao(self, omega, mu, U: float) -> np.ndarray:
+        """Complex RAOs (3, …) of heave (z down) [m/m], roll [rad/m], pitch [rad/m] at O (module doc).
+
+        omega [rad/s] > 0 and mu [rad] broadcast together; U [m/s] ≥ 0.
+        """
+        Z, X, _, shape = self._system(omega, mu, U)
         out = np.linalg.solve(Z, X[..., None])[..., 0][:, self._out]
         return np.moveaxis(out, -1, 0).reshape((3,) + shape)
+
+    def roll_receptance(self, omega, mu, U: float) -> np.ndarray:
+        """Roll per unit roll moment h_φ [rad/(N m)] at the encounter frequency of (ω, μ) (complex, shape of
+        the broadcast inputs): the (roll, roll) element of Z⁻¹, with sway (and yaw) free as in :meth:`rao`.
+        A change δ = ΔC₄₄ + iω_e ΔB₄₄ of the roll stiffness and damping scales the roll RAO by
+        1/(1 + δ h_φ) (Sherman–Morrison; heave and pitch are uncoupled from roll by symmetry)."""
+        Z, _, _, shape = self._system(omega, mu, U)
+        e = np.zeros(Z.shape[:2], dtype=complex)
+        e[:, self._out[1]] = 1.0
+        h = np.linalg.solve(Z, e[..., None])[..., 0][:, self._out[1]]
+        return h.reshape(shape)
+
+    @property
+    def roll_scales(self) -> tuple[float, float]:
+        """(C₄₄ [N m/rad], 2 C₄₄/ω_n [N m s/rad]): the design roll stiffness and critical damping at the design
+        roll natural frequency, the units in which a fit reports roll stiffness and damping changes."""
+        r = self._out[1]
+        c44 = float(self.C[r, r])
+        return c44, 2.0 * c44 / float(self.attrs["roll_natural_frequency"])
+
+    def roll_damping_ratio(self, U: float) -> float:
+        """The design's roll damping at speed U [m/s] as a fraction of :attr:`roll_scales`' critical damping:
+        the fixed ratio plus the per-speed term."""
+        return float(self.attrs.get("roll_damping_ratio", 0.0)) + self.B44_per_speed * U / self.roll_scales[1]
 
     def vertical(self, rao, x: float, y: float = 0.0) -> np.ndarray:
         """Vertical displacement UP [m/m] of the point (x, y) from O (body axes) from rao (3, …) of :meth:`rao`."""

@@ -117,10 +117,11 @@ def run_windows(record, min_s: float = 120.0) -> list[tuple[int, float, float]]:
     return out
 
 
-def design_responses(design, names, omega, mu, U: float, site) -> np.ndarray:
+def design_responses(design, names, omega, mu, U: float, site, R=None) -> np.ndarray:
     """(len(names), …) complex design RAOs of 'heave' (UP at the IMU site), 'roll', 'pitch', 'acc'
-    (earth-down acceleration at the site, −ω_e² × the downward displacement)."""
-    R = design.rao(omega, mu, U)
+    (earth-down acceleration at the site, −ω_e² × the downward displacement); ``R``: the design's
+    (heave, roll, pitch) RAOs at (omega, mu, U) if already computed (or a part of them)."""
+    R = design.rao(omega, mu, U) if R is None else R
     up = design.vertical(R, site[0], site[1])
     out = []
     for n in names:
