@@ -28,7 +28,7 @@ from vtrials.physics.seakeeping import linearize as LZ
 from vtrials.physics.seakeeping import rao as rao_mod
 from vtrials.physics.seakeeping.database import load_database
 from vtrials.physics.seakeeping.timedomain import memory_model
-from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
+from vtrials.physics.seakeeping.timedomain import flow_geometry, roll_damping_of, seakeeping_vessel
 from vtrials.physics import steering as H
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
@@ -107,7 +107,8 @@ def test_irregular_beam_seas_rms_roll(patrol):
     v2, _ = seakeeping_vessel(ves, db, comp, dt, model=model, drift=False)
     rd = roll_damping_of(ves, db)
     v0, _ = seakeeping_vessel(ves, db, np.zeros((0, 6)), dt, model=model, drift=False)
-    _, Jv, Je, Jd = LZ.force_jacobians(v0, start, dt)
+    _, Jv, Je, Jd, Jf = LZ.force_jacobians(v0, start, dt, with_flow=True)
+    fl = dict(Jf=Jf, flow=flow_geometry(ves))   # the maneuvering forces see the waves' flow, as in the time domain
     Jc = LZ.coriolis_jacobian(v0, start.u)
     ap = ves.autopilot
     auto = (*ap.pid, float(ves.steering[0, 2]))
@@ -129,14 +130,14 @@ def test_irregular_beam_seas_rms_roll(patrol):
     sigma_p = 0.0
     for _ in range(50):
         beq = float(rd.stochastic(u_mean, sigma_p)) - float(rd.B1(u_mean))   # B₁ is in Jv already
-        R = LZ.coupled_rao(v2, db, comp[:, 1], beta, u_mean, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto)
+        R = LZ.coupled_rao(v2, db, comp[:, 1], beta, u_mean, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto, **fl)
         new = math.sqrt(float(np.sum(0.5 * comp[:, 0] ** 2 * np.abs(we_c * R[:, 3]) ** 2)))
         if abs(new - sigma_p) < 1e-9:
             break
         sigma_p = new
     w = np.linspace(db.omega[0], db.omega[-1], 1500)
     S = spectrum("jonswap", w, HS_BEAM, peak_frequency("jonswap", 3.3, tp=TP), 3.3)
-    Rs = LZ.coupled_rao(v2, db, w, beta, u_mean, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto)
+    Rs = LZ.coupled_rao(v2, db, w, beta, u_mean, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto, **fl)
     p_td = float(np.std(tr[keep, sim.rec_names.index("p")]))
     print(f"U={u_mean:.2f}: σ_p time domain {p_td:.5g}, linearised {sigma_p:.5g}; B_eq {float(rd.stochastic(u_mean, sigma_p)):.4g}")
     for d, col in ((2, "z"), (3, "roll"), (4, "pitch")):

@@ -32,7 +32,7 @@ from vtrials.physics.seakeeping import linearize as LZ
 from vtrials.physics.seakeeping import rao as rao_mod
 from vtrials.physics.seakeeping.database import load_database
 from vtrials.physics.seakeeping.timedomain import memory_model
-from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
+from vtrials.physics.seakeeping.timedomain import flow_geometry, roll_damping_of, seakeeping_vessel
 from vtrials.physics.simulator import ShipState, Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
 
@@ -168,12 +168,12 @@ def linearised(patrol):
         start = ShipState(shaft_rps=(0.0,) * len(ves.shafts))
         if U > 0.0:
             start = Simulator(ves, 1, DT_C).self_propulsion(0, U)
-        _, Jv, Je, Jd = LZ.force_jacobians(v0, start, DT_C)
+        _, Jv, Je, Jd, Jf = LZ.force_jacobians(v0, start, DT_C, with_flow=True)
         Jc = LZ.coriolis_jacobian(v0, start.u)
         ap = ves.autopilot
         auto = (*ap.pid, float(ves.steering[0, 2])) \
             if U > 0.0 else None
-        out[U] = (start, Jv, Je, Jc, Jd, auto)
+        out[U] = (start, Jv, Je, Jc, Jd, auto, Jf)
     return rd, out
 
 
@@ -181,9 +181,9 @@ def linearised(patrol):
 def test_coupled_heave_roll_pitch_match_rao(patrol, linearised, beta_deg, speed, omega):
     ves, db, model = patrol
     rd, lin = linearised
-    start, Jv, Je, Jc, Jd, auto = lin[speed]
+    start, Jv, Je, Jc, Jd, auto, Jf = lin[speed]
     beta = math.radians(beta_deg)
-    kw = dict(Jd=Jd, autopilot=auto)
+    kw = dict(Jd=Jd, autopilot=auto, Jf=Jf, flow=flow_geometry(ves))   # waves' flow, as in the time domain
     comp = np.array([[AMP_C, omega, omega ** 2 / db.g, math.cos(beta), math.sin(beta), 0.3]])
     v2, _ = seakeeping_vessel(ves, db, comp, DT_C, model=model, drift=False)
     we0 = float(rao_mod.encounter_frequency(omega, beta, start.u, db.g))
@@ -258,7 +258,7 @@ LONG_WAVES = (0.2, 0.25, 0.3)
 def test_long_beam_waves_sway_with_the_water_and_heel_with_the_slope(patrol, linearised):
     ves, db, model = patrol
     rd, lin = linearised
-    start, Jv, Je, Jc, Jd, auto = lin[0.0]
+    start, Jv, Je, Jc, Jd, auto, _ = lin[0.0]
     v0, _ = seakeeping_vessel(ves, db, np.zeros((0, 6)), DT_C, model=model, drift=False)
     w = np.array(LONG_WAVES)
     r = LZ.coupled_rao(v0, db, w, math.pi / 2, 0.0, Jv, Je, Jc, rd, AMP_C)

@@ -77,17 +77,26 @@ class _ShipModel:
         self.v0, _ = sea_ship(scn.vessel, self.db, np.zeros((0, 6)), self.dt, mean_force="none")
         self.rd = roll_damping_of(scn.vessel, self.db)
         self._jac = {}
+        self._flow = {}
 
     def jacobians(self, U: float):
         from vtrials.physics.seakeeping import linearize as LZ
+        from vtrials.physics.seakeeping.timedomain import flow_geometry
         from vtrials.physics.simulator import Simulator
         key = round(U, 3)
         if key not in self._jac:
             start = Simulator(self.ves, 1, self.dt).self_propulsion(0, U)
-            _, Jv, Je, Jd = LZ.force_jacobians(self.v0, start, self.dt)
+            _, Jv, Je, Jd, Jf = LZ.force_jacobians(self.v0, start, self.dt, with_flow=True)
             Jc = LZ.coriolis_jacobian(self.v0, start.u)
             self._jac[key] = (start.u, Jv, Je, Jd, Jc)
+            self._flow[key] = dict(Jf=Jf, flow=flow_geometry(self.ves))
         return self._jac[key]
+
+    def flow_kw(self, U: float) -> dict:
+        """The waves'-flow arguments of :func:`~vtrials.physics.seakeeping.linearize.coupled_rao` at speed U
+        (the maneuvering forces see the motion relative to the waves' flow, as in the time domain)."""
+        self.jacobians(U)
+        return self._flow[round(U, 3)]
 
     def linear_parts(self, U: float):
         """(u, J_ν, J_η, J_δ, J_c, autopilot) of the linearisation at speed U (the ship's own heading
@@ -113,7 +122,7 @@ class _ShipModel:
             beq = float(self.rd.stochastic(U, sigma_p)) - b1  # B₁ is in J_ν already
             for j in range(n):
                 R[j] = LZ.coupled_rao(self.v0, self.db, comp[j:j + 1, 1], float(beta[j]), U, Jv, Je, Jc, roll_beq=beq,
-                                      Jd=Jd, autopilot=auto)[0]
+                                      Jd=Jd, autopilot=auto, **self.flow_kw(U))[0]
             new = math.sqrt(float(np.sum(0.5 * comp[:, 0] ** 2 * np.abs(we * R[:, 3]) ** 2)))
             if abs(new - sigma_p) <= 1e-4 * max(new, 1e-9):
                 sigma_p = new
@@ -160,7 +169,8 @@ def true_transfer(model: _ShipModel, comp: np.ndarray, ref: dict, leg: dict, pro
     rao0 = {n: np.full(wb.size, np.nan + 0j) for n in RESP}
     if np.any(unique):
         om = W[unique, 0]
-        R0 = LZ.coupled_rao(model.v0, db, om, beta0, U, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto)
+        R0 = LZ.coupled_rao(model.v0, db, om, beta0, U, Jv, Je, Jc, roll_beq=beq, Jd=Jd, autopilot=auto,
+                            **model.flow_kw(U))
         k0 = om ** 2 / G
         we0 = om - k0 * U * math.cos(beta0)
         ph0 = np.exp(1j * k0 * (xp * math.cos(beta0) + yp * math.sin(beta0)))

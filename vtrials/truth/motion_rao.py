@@ -2,8 +2,8 @@
 compared with (models/<ship>/design/README.md, benchmarks/design_rao_vs_truth.py).
 
 The coupled six-DOF frequency-domain model of :func:`vtrials.physics.seakeeping.linearize.coupled_rao`
-(the truth database's coefficients, ship.toml's restoring, the maneuvering model in surge/sway/yaw, the
-heading autopilot through the steering gear, the viscous roll damping of hull.toml, its quadratic part
+(the truth database's coefficients, ship.toml's restoring, the maneuvering model in surge/sway/yaw acting
+on the motion relative to the waves' flow, the heading autopilot through the steering gear, the viscous roll damping of hull.toml, its quadratic part
 linearised stochastically for a given roll-rate standard deviation) — the model the simulator
 integrates, verified against it in tests/test_seakeeping_irregular.py.
 """
@@ -17,7 +17,7 @@ import numpy as np
 from vtrials.physics.seakeeping import linearize as LZ
 from vtrials.physics.seakeeping.database import load_database
 from vtrials.physics.seakeeping.timedomain import memory_model
-from vtrials.physics.seakeeping.timedomain import roll_damping_of, seakeeping_vessel
+from vtrials.physics.seakeeping.timedomain import flow_geometry, roll_damping_of, seakeeping_vessel
 from vtrials.physics.simulator import Simulator
 from vtrials.physics.vessel import load_vessel, model_dir
 
@@ -32,7 +32,8 @@ class TruthRAO:
         start = Simulator(self.vessel, 1, dt).self_propulsion(0, U)
         self.U = float(start.u)
         self.v0, _ = seakeeping_vessel(self.vessel, self.db, np.zeros((0, 6)), dt, model=model, drift=False)
-        _, self.Jv, self.Je, self.Jd = LZ.force_jacobians(self.v0, start, dt)
+        _, self.Jv, self.Je, self.Jd, self.Jf = LZ.force_jacobians(self.v0, start, dt, with_flow=True)
+        self.flow = flow_geometry(self.vessel)
         self.Jc = LZ.coriolis_jacobian(self.v0, self.U)
         self.rd = roll_damping_of(self.vessel, self.db)
         ap = self.vessel.autopilot
@@ -43,7 +44,7 @@ class TruthRAO:
         relative to the heading (π head seas); quadratic roll damping linearised at roll-rate std σ_p [rad/s]."""
         beq = float(self.rd.stochastic(self.U, sigma_p)) - float(self.rd.B1(self.U))
         R = LZ.coupled_rao(self.v0, self.db, np.atleast_1d(omega), float(mu), self.U, self.Jv, self.Je, self.Jc,
-                           roll_beq=beq, Jd=self.Jd, autopilot=self.auto)
+                           roll_beq=beq, Jd=self.Jd, autopilot=self.auto, Jf=self.Jf, flow=self.flow)
         return R[:, 2:5].T
 
     def roll_rate_std(self, omega, S, mu: float, iters: int = 60) -> float:

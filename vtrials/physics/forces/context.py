@@ -41,4 +41,6 @@ AUX_PROP = 0  # propeller k occupies AUX_PROP + 8k .. +7
 P_THRUST, P_TORQUE, P_J, P_KT, P_KQ, P_UA, P_WAKE, P_N = range(8)
 AUX_RUD = 32  # rudder k occupies AUX_RUD + 8k .. +7
 R_FN, R_UR, R_VR, R_ALPHA, R_UR2 = range(5)
-NAUX = 64
+AUX_FLOW = 64  # 64..66: the waves' cross-flow v_w [m/s], its gradient r_w [1/s], surface heel φ_w [rad]
+#               (written by wave_flow, subtracted by the maneuvering components; zero without waves)
+NAUX = 72

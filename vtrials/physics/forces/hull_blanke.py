@@ -111,10 +111,12 @@ def resistance(p, u):
 @nb.njit(cache=True, fastmath=False, inline="always")
 def kernel(p, s, env, ctx, aux, w):
     u = ctx[L.NU_R + 0]
-    v = ctx[L.NU_R + 1]
+    # cross-flow, yaw rate and heel relative to the waves' flow and surface (wave_flow; zero in calm water)
+    v = ctx[L.NU_R + 1] - aux[L.AUX_FLOW]
     pr = ctx[L.NU_R + 3]
-    r = ctx[L.NU_R + 5]
-    phi = ctx[L.EUL + 0]
+    r = ctx[L.NU_R + 5] - aux[L.AUX_FLOW + 1]
+    phi_abs = ctx[L.EUL + 0]
+    phi = phi_abs - aux[L.AUX_FLOW + 2]
     au = abs(u)
     av = abs(v)
     ar = abs(r)
@@ -125,7 +127,7 @@ def kernel(p, s, env, ctx, aux, w):
          + p[6] * phi * auv + p[7] * phi * aur + p[8] * phi * u * u)
     K = (p[9] * au * v + p[10] * u * r + p[11] * v * av + p[12] * v * ar + p[13] * r * av
          + p[14] * phi * auv + p[15] * phi * aur + p[16] * phi * u * u + p[17] * au * pr
-         + p[18] * pr * abs(pr) + p[19] * pr + p[20] * phi ** 3)
+         + p[18] * pr * abs(pr) + p[19] * pr + p[20] * phi_abs ** 3)
     N = (p[21] * au * v + p[22] * au * r + p[23] * r * ar + p[24] * r * av + p[25] * phi * auv
          + p[26] * phi * u * ar + p[27] * phi * u * au)
     w[0] = X

@@ -62,8 +62,8 @@ def kernel(p, s, env, ctx, aux, w):
     d = p[1]
     rho = p[2]
     u = ctx[L.NU_R + 0]
-    v = ctx[L.NU_R + 1]
-    r = ctx[L.NU_R + 5]
+    v = ctx[L.NU_R + 1] - aux[L.AUX_FLOW]          # relative to the waves' cross-flow (wave_flow)
+    r = ctx[L.NU_R + 5] - aux[L.AUX_FLOW + 1]
     U2 = u * u + v * v
     Ud = math.sqrt(U2)
     if Ud < p[3]:

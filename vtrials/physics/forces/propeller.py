@@ -276,8 +276,8 @@ def kernel(p, s, env, ctx, aux, w):
     rho = p[P_RHO]
     D = p[P_D]
     u = ctx[L.NU_R + 0]
-    v = ctx[L.NU_R + 1]
-    r = ctx[L.NU_R + 5]
+    v = ctx[L.NU_R + 1] - aux[L.AUX_FLOW]          # relative to the waves' cross-flow (wave_flow)
+    r = ctx[L.NU_R + 5] - aux[L.AUX_FLOW + 1]
     if u > 0.0:
         if p[P_WAKE] > 0.0:
             U = math.sqrt(u * u + v * v)

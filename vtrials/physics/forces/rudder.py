@@ -108,8 +108,8 @@ def kernel(p, s, env, ctx, aux, w):
     zR = p[9]
     D = p[19]
     u = ctx[L.NU_R + 0]
-    v = ctx[L.NU_R + 1]
-    r = ctx[L.NU_R + 5]
+    v = ctx[L.NU_R + 1] - aux[L.AUX_FLOW]          # relative to the waves' cross-flow (wave_flow)
+    r = ctx[L.NU_R + 5] - aux[L.AUX_FLOW + 1]
     U = math.sqrt(u * u + v * v)
     beta = math.atan2(-v, u)
     delta = ctx[L.DELTA + k]

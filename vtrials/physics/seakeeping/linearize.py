@@ -19,7 +19,11 @@ DOFs (sway, heave, roll, pitch), its inputs ξ̂ being the body sway velocity v�
 vertical velocity iω_e ẑ and the roll and pitch rates iω_e φ̂, iω_e θ̂. Quadratic roll damping: harmonic equivalent linearisation B_eq = (8/3π) ω_e φ_a B₂ at the
 response amplitude (iterated). Then
 
-    [iω_e (M_RB + M_A) T − J_ν T + C_ν T − J_η + iω_e K̂ + iω_e B_eq] η̂ = X(ω, β) a.
+    [iω_e (M_RB + M_A) T − J_ν T + C_ν T − J_η + iω_e K̂ + iω_e B_eq] η̂ = (X(ω, β) + J_f f̂(ω, β)) a,
+
+J_f f̂ the maneuvering forces of the waves' flow (cross-flow, its gradient, surface heel: the maneuvering
+components act on the motion relative to it, :mod:`vtrials.physics.forces.wave_flow`), J_f = ∂τ/∂(v_w,
+r_w, φ_w) by the same central differences.
 """
 
 from __future__ import annotations
@@ -29,10 +33,11 @@ import math
 import numpy as np
 
 from vtrials.physics.forces import context as L
+from vtrials.physics.forces import wave_flow
 from vtrials.physics.seakeeping.radiation import extended_coefficients
 from vtrials.physics.seakeeping.rao import encounter_frequency
 
-WAVE_COMPONENTS = ("radiation", "wave_excitation", "wave_drift")
+WAVE_COMPONENTS = ("radiation", "wave_excitation", "wave_drift", "wave_flow")
 
 
 def kirchhoff_coriolis(M: np.ndarray, nu: np.ndarray, munk: bool = True) -> np.ndarray:
@@ -68,12 +73,15 @@ def _set(sim, base_q, base_v, eta, nu, delta=0.0):
     return R
 
 
-def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a: float = 1e-5):
+def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a: float = 1e-5,
+                    with_flow: bool = False):
     """(τ0, J_ν, J_η, R_η) of a seakeeping vessel at ``start`` (a :class:`~vtrials.physics.simulator.ShipState`
     with speed u, zero angles and the shaft speeds): the sum of its force components other than the wave
     components, by central differences of the kernels (via ``Simulator.evaluate``: forces at a state, no
     time step). J_ν (6×6) per body velocity, J_η (6×6) per (x, y, z, φ, θ, ψ) including the weight,
-    J_δ (6,) per rudder angle (all rudders together). Returns (τ0, J_ν, J_η, J_δ)."""
+    J_δ (6,) per rudder angle (all rudders together). Returns (τ0, J_ν, J_η, J_δ), and with ``with_flow``
+    also J_f (6×3) per (v_w, r_w, φ_w), the waves' flow the maneuvering components see
+    (:mod:`vtrials.physics.forces.wave_flow`)."""
     from vtrials.physics.simulator import Simulator
     sim = Simulator(vessel, 1, dt)
     sim.set_state(0, start)
@@ -85,8 +93,9 @@ def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a:
     mg = vessel.mass * 9.80665
     rG = vessel.r_G
 
-    def tau(eta, nu, delta=0.0):
+    def tau(eta, nu, delta=0.0, flow=(0.0, 0.0, 0.0)):
         R = _set(sim, base_q, base_v, eta, nu, delta)
+        sim.aux[0, L.AUX_FLOW:L.AUX_FLOW + 3] = flow     # the waves' flow (no wave_flow component here)
         sim.evaluate()
         t = sim.comp_w[0, keep].sum(axis=0)
         g = mg * R[6:9]                              # weight in body axes (world z down)
@@ -103,7 +112,15 @@ def force_jacobians(vessel, start, dt: float = 0.02, eps_v: float = 1e-4, eps_a:
         d[j] = eps_a
         Je[:, j] = (tau(eta0 + d, nu0) - tau(eta0 - d, nu0)) / (2 * eps_a)
     Jd = (tau(eta0, nu0, eps_a) - tau(eta0, nu0, -eps_a)) / (2 * eps_a)
+    Jf = np.zeros((6, 3))
+    for j, e in enumerate((eps_v, eps_v, eps_a)):
+        f = np.zeros(3)
+        f[j] = e
+        Jf[:, j] = (tau(eta0, nu0, 0.0, f) - tau(eta0, nu0, 0.0, -f)) / (2 * e)
     _set(sim, base_q, base_v, eta0, nu0)
+    sim.aux[0, L.AUX_FLOW:L.AUX_FLOW + 3] = 0.0
+    if with_flow:
+        return t0, Jv, Je, Jd, Jf
     return t0, Jv, Je, Jd
 
 
@@ -139,7 +156,7 @@ def _memory_dofs_of(vessel) -> list[int]:
 
 def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_damping=None, amplitude: float = 0.0,
                 iters: int = 30, excitation_dofs=(0, 1, 2, 3, 4, 5), Jd=None, autopilot=None,
-                roll_beq=None, memory_dofs=None) -> np.ndarray:
+                roll_beq=None, memory_dofs=None, Jf=None, flow=None) -> np.ndarray:
     """Complex RAO (nω, 6) of (x, y, z, φ, θ, ψ) per metre of wave amplitude of the coupled system above.
 
     vessel: the seakeeping vessel (its M_RB and M_A, i.e. A∞ in heave/roll/pitch); Jv, Je, Jc from
@@ -152,7 +169,10 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
     J_δ δ̂ with δ̂ = −(K_p + K_i/(iω_e) + K_d iω_e) ψ̂ / (1 + iω_e T).
     ``roll_beq``: a fixed equivalent linear roll damping [N m s] added instead of the harmonic
     linearisation of B₂ (e.g. the stochastic one for irregular seas). ``memory_dofs``: the DOFs of the
-    radiation memory (default: those of the vessel's radiation component)."""
+    radiation memory (default: those of the vessel's radiation component). ``Jf`` (from
+    :func:`force_jacobians` ``with_flow``) with ``flow`` = (length, depth) of
+    :func:`.timedomain.flow_geometry`: the maneuvering forces see the waves' flow, an excitation
+    J_f (v̂_w, r̂_w, φ̂_w) (:func:`vtrials.physics.forces.wave_flow.flow_rao`)."""
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     we = encounter_frequency(omega, beta, U, db.g)
     A, B = extended_coefficients(db.omega, db.A, db.B, db.A_inf, np.abs(we))
@@ -162,6 +182,8 @@ def coupled_rao(vessel, db, omega, beta: float, U: float, Jv, Je, Jc, roll_dampi
     mask = np.zeros(6)
     mask[list(excitation_dofs)] = 1.0
     Xw = Xw * mask
+    if Jf is not None:
+        Xw = Xw + (np.asarray(Jf) @ wave_flow.flow_rao(omega, beta, flow[0], flow[1], db.g)).T
     M = vessel.M_RB + vessel.M_A
     E = np.zeros((6, 6))
     E[1, 5] = -1.0

@@ -36,6 +36,11 @@ How the two models combine (nothing counted twice):
     lift, bilge keels); ``method = "hull_model"``: those removed terms come back in the component,
     less the database's potential damping B44(ω_n) at the natural roll frequency (so the total at
     ω_n is the ship file's, the wave part now frequency-dependent from the memory).
+* The maneuvering forces (hull, rudders, propellers) see the ship's sway, yaw rate and heel relative to
+  the waves' cross-flow, its gradient along the ship and the surface slope, averaged over the hull
+  (:mod:`vtrials.physics.forces.wave_flow`): lift is a force of the motion relative to the water. On
+  the absolute motion, patrol51 at 9 m/s heeled 3.0–3.6 × the slope of long beam waves (at rest 1.08 ×)
+  and rolled about twice as much in bow seas as with the relative flow.
 * Mean drift (surge, sway, yaw): the database's zero-speed drift per component
   (:mod:`vtrials.physics.forces.wave_drift`); the maneuvering model's calm-water resistance is unchanged,
   so the added resistance is this force alone.
@@ -63,7 +68,7 @@ from vtrials.errors import InputError
 from vtrials.physics.forces import roll_damping as rd_mod
 from vtrials.physics.forces import hydrostatics
 from vtrials.physics.forces import radiation as rad_force
-from vtrials.physics.forces import wave_drift, wave_excitation
+from vtrials.physics.forces import wave_drift, wave_excitation, wave_flow
 from vtrials.physics.forces.registry import Component
 from vtrials.physics.seakeeping.radiation import fit_radiation
 
@@ -71,6 +76,12 @@ SEAKEEPING_DOFS = (2, 3, 4)
 #: DOFs of the radiation memory: the seakeeping DOFs and sway (see the module notes: the sway–roll
 #: coupling and the sway added mass in waves are the database's, so that the long-wave limit holds).
 MEMORY_DOFS = (1, 2, 3, 4)
+
+
+def flow_geometry(vessel) -> tuple[float, float]:
+    """(length [m], depth [m]) over and at which the maneuvering forces see the waves' flow
+    (:mod:`vtrials.physics.forces.wave_flow`): L_pp and half the draught."""
+    return float(vessel.particulars.length), 0.5 * float(vessel.particulars.draught)
 
 
 def memory_model(db):
@@ -115,7 +126,8 @@ def roll_damping_of(vessel, db, hull_toml=None):
 
 
 def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
-                      excitation_dofs=(0, 1, 2, 3, 4, 5), drift: bool = True, roll_damping="model"):
+                      excitation_dofs=(0, 1, 2, 3, 4, 5), drift: bool = True, roll_damping="model",
+                      relative_flow: bool = True):
     """A shallow copy of ``vessel`` with A∞ in its added mass (heave/roll/pitch block), the damping
     component reduced to its roll (viscous) part, and the radiation and wave-excitation components.
 
@@ -124,7 +136,9 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
     :class:`.radiation.RadiationModel` (fitted here when None); ``drift``: add the mean drift
     component (:mod:`vtrials.physics.forces.wave_drift`); ``roll_damping``: "model" (from the
     model's hull.toml, :func:`roll_damping_of`), a :class:`~vtrials.physics.forces.roll_damping.RollDamping`,
-    or None (no viscous roll damping at all: potential damping only). Returns (vessel, model).
+    or None (no viscous roll damping at all: potential damping only); ``relative_flow``: the maneuvering
+    components see the ship's motion relative to the waves' flow and surface (:mod:`.forces.wave_flow`,
+    first in the component list; False only to measure what that changes). Returns (vessel, model).
     """
     if isinstance(roll_damping, str):
         if roll_damping != "model":
@@ -146,6 +160,8 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
         M_A[j, 1] = db.A_inf[j, 1]
     v.M_A = M_A
     comps = []
+    if relative_flow and len(components):
+        comps.append(Component("wave_flow", "wave_flow", wave_flow.pack(components, *flow_geometry(vessel))))
     for c in vessel.components:
         if c.name == "damping":
             p = c.params.copy()
@@ -172,4 +188,4 @@ def seakeeping_vessel(vessel, db, components: np.ndarray, dt: float, model=None,
     return v, model
 
 
-__all__ = ["seakeeping_vessel", "roll_damping_of", "memory_model", "hydrostatics", "MEMORY_DOFS"]
+__all__ = ["seakeeping_vessel", "roll_damping_of", "memory_model", "hydrostatics", "MEMORY_DOFS", "flow_geometry"]
