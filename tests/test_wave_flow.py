@@ -154,3 +154,28 @@ def test_long_beam_waves_at_speed_no_longer_heel_the_ship_by_the_lift():
     assert np.all(np.abs(rel[:, 3]) / slope < 1.3)
     assert np.all(np.abs(np.abs(rel[:, 1]) - 1.0) < 0.25)
     assert np.all(np.abs(absolute[:, 3]) / slope > 2.5)      # what the flow takes away
+
+
+def test_steady_states_of_a_ship_in_waves_are_calm_water():
+    """Self-propulsion and the steady speed of an order are calm-water balances: on a simulator whose ship
+    carries wave components they are solved without them (a frozen wave force at t = 0 used to enter the
+    balance, and with the waves' flow one airwake-survey replicate found no root), and equal the calm
+    vessel's."""
+    from vtrials.physics.environment.waves import Waves, realize
+    from vtrials.physics.seakeeping.database import load_database
+    from vtrials.physics.seakeeping.timedomain import memory_model, seakeeping_vessel
+    from vtrials.physics.simulator import Simulator
+    from vtrials.physics.vessel import load_vessel, model_dir
+    ves = load_vessel("patrol51")
+    db = load_database(model_dir("patrol51") / "hydro" / "patrol51_hydro.nc")
+    comp = realize(Waves(hs_m=3.0, tp_s=8.0, direction_deg=40.0, spreading_s=10.0, n_components=60),
+                   math.inf, np.random.default_rng(5)).components
+    comp = comp[(comp[:, 1] >= db.omega[0]) & (comp[:, 1] <= db.omega[-1])]
+    v2, _ = seakeeping_vessel(ves, db, comp, 0.05, model=memory_model(db))
+    sea, calm = Simulator(v2, 1, 0.05), Simulator(ves, 1, 0.05)
+    a, b = sea.self_propulsion(0, 9.0), calm.self_propulsion(0, 9.0)
+    np.testing.assert_allclose(a.shaft_rps, b.shaft_rps, rtol=1e-9)
+    np.testing.assert_allclose([a.z, a.roll, a.pitch], [b.z, b.roll, b.pitch], atol=1e-9)
+    rps = ves.telegraph["standard"][0]
+    a, b = sea.steady_at_order(0, (rps,) * sea.ns), calm.steady_at_order(0, (rps,) * calm.ns)
+    assert a.u == pytest.approx(b.u, rel=1e-9)

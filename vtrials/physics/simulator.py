@@ -76,6 +76,10 @@ class _Shard:
         return self.rec
 
 
+#: Component types of the sea (waves and their loads): left out of the calm-water steady states.
+SEA_COMPONENT_TYPES = ("radiation", "wave_excitation", "wave_drift", "wave_flow", "added_resistance")
+
+
 @dataclasses.dataclass
 class ShipState:
     """A ship's initial condition (SI; velocities through the water, body axes)."""
@@ -166,6 +170,9 @@ class Simulator:
         self.qfrc = self.batch.bind("qfrc_applied")
         self.time = self.batch.bind("time")
         comps = vessel.components if components is None else components
+        self.components = list(comps)
+        self._calm_sim = None
+        self._gravity = float(gravity)
         self.comp_names = [c.name for c in comps]
         self.comp_types = list(dict.fromkeys(component_type(c.type) for c in comps))
         self.comp_kind = np.array([self.comp_types.index(component_type(c.type)) for c in comps], dtype=np.int64)
@@ -622,6 +629,20 @@ class Simulator:
         self._krow = 0
 
     # ------------------------------------------------------------------ steady states
+    def _calm_twin(self, ship: int):
+        """(simulator, index) on which ship ``ship``'s calm-water steady states are solved: this one if it has
+        no sea components (:data:`SEA_COMPONENT_TYPES`), else a one-ship twin without them (same vessel, step,
+        limits and the ship's environment block), so that a frozen wave force at one instant does not enter
+        a calm-water balance."""
+        if not any(c.type in SEA_COMPONENT_TYPES for c in self.components):
+            return self, ship
+        if self._calm_sim is None:
+            self._calm_sim = Simulator(self.vessel, 1, self.dt, envs=self.env[ship], record_every=0,
+                                       limits=tuple(self.limits), planar=self.planar, gravity=self._gravity,
+                                       components=[c for c in self.components if c.type not in SEA_COMPONENT_TYPES])
+        self._calm_sim.env[0] = self.env[ship]
+        return self._calm_sim, 0
+
     def _surge_residual(self, ship: int, s: ShipState) -> float:
         """Net surge force of condition s (straight ahead, rudders amidships)."""
         self.set_state(ship, s)
@@ -647,6 +668,11 @@ class Simulator:
         which the surge forces balance, and the heave, heel and trim at which the heave force, roll
         and pitch moments balance; returns that condition (also placed on the ship).
         """
+        twin, k = self._calm_twin(ship)
+        if twin is not self:
+            s = twin.self_propulsion(k, speed, heading, pitch, trim_iterations)
+            self.set_state(ship, s)
+            return s
         s = ShipState(heading=heading, u=speed, shaft_rps=(0.0,) * self.ns, pitch_ratio=tuple(pitch))
         n_hi = float(np.max([sh.max_rps for sh in self.vessel.shafts]))
 
@@ -667,6 +693,11 @@ class Simulator:
                         trim_iterations: int = 4) -> ShipState:
         """The calm-water steady straight-ahead speed at the given shaft speeds and pitch ratios
         (dead in the water when they give no ahead thrust); returns that condition."""
+        twin, k = self._calm_twin(ship)
+        if twin is not self:
+            s = twin.steady_at_order(k, rps, pitch, heading, trim_iterations)
+            self.set_state(ship, s)
+            return s
         s = ShipState(heading=heading, u=0.0, shaft_rps=tuple(rps), pitch_ratio=tuple(pitch))
         if self._surge_residual(ship, s) <= 0.0:
             self.set_state(ship, s)
