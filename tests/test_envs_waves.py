@@ -112,6 +112,6 @@ def test_seaway_params_are_sea_ships_blocks():
     sv, _ = sea_ship(v, db, comp, 0.02)
     blocks = {c.name: c.params for c in sv.components}
     par = seaway_params(v, db, comp)
-    assert set(par) == {"wave_excitation", "added_resistance", "wave_drift"}
+    assert set(par) == {"wave_excitation", "wave_flow", "added_resistance", "wave_drift"}
     for name, p in par.items():
         np.testing.assert_array_equal(p, blocks[name])

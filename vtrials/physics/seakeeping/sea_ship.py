@@ -23,9 +23,9 @@ import math
 import numpy as np
 
 from vtrials.errors import InputError
-from vtrials.physics.forces import added_resistance, seakeeping_coriolis, wave_drift, wave_excitation
+from vtrials.physics.forces import added_resistance, seakeeping_coriolis, wave_drift, wave_excitation, wave_flow
 from vtrials.physics.forces.registry import Component
-from vtrials.physics.seakeeping.timedomain import seakeeping_vessel
+from vtrials.physics.seakeeping.timedomain import flow_geometry, seakeeping_vessel
 
 MEAN_FORCES = ("snnm", "database", "none")
 
@@ -59,6 +59,8 @@ def seaway_params(vessel, db, components: np.ndarray, mean_force: str = "snnm",
     if mean_force not in MEAN_FORCES:
         raise InputError("seaway_params", "mean_force", f"{mean_force!r} is not one of {', '.join(MEAN_FORCES)}")
     out = {"wave_excitation": wave_excitation.pack(db, components, excitation_dofs)}
+    if len(components):
+        out["wave_flow"] = wave_flow.pack(components, *flow_geometry(vessel))
     if mean_force == "database":
         out["wave_drift"] = wave_drift.pack(db, components)
     elif mean_force == "snnm":
