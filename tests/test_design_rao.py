@@ -68,11 +68,14 @@ def test_long_wave_limits_and_symmetry(design):
 
 def test_design_differs_from_truth_but_not_wildly(design):
     """RMS response in a long-crested JONSWAP sea (H_s 2 m, T_p 8 s) at 5 m/s, design vs the simulator's
-    coupled truth. Measured: head seas heave +14 %, pitch +11 %; 135°: heave +11 %, roll −2 %, pitch +9 %;
-    beam: heave +1 %, roll +19 % (no hull lift on sway and none of the maneuvering model's speed-dependent
-    roll moments in the design model; pitch in beam seas is a few per cent of its head-sea value). Neither
-    identical (some component ≥ 5 % off at each heading) nor wildly off (heave and pitch within 30 %
-    where they matter, roll within 35 %)."""
+    coupled truth. Measured: head seas heave +14 %, pitch +11 %; 135°: heave +11 %, roll +106 %, pitch
+    +9 %; beam: heave +1 %, roll −9 % (pitch in beam seas is a few per cent of its head-sea value).
+    Neither identical (some component ≥ 5 % off at each heading) nor wildly off in heave and pitch (within
+    30 % where they matter) and beam-sea roll (within 35 %). Bow-sea roll at speed is the exception, stated
+    and bounded (within +130 %): the truth's maneuvering forces act on the motion relative to the waves'
+    cross-flow (vtrials.physics.forces.wave_flow), whose lift roughly halves its bow-sea roll at 5 m/s,
+    and this zero-speed design model has no such term (before that change, with the lift on the
+    absolute motion, the design was −2 % here; models/patrol51/design/README.md)."""
     from vtrials.truth.motion_rao import TruthRAO
     U = 5.0
     truth = TruthRAO("patrol51", U)
@@ -93,8 +96,10 @@ def test_design_differs_from_truth_but_not_wildly(design):
         assert abs(dh) <= 0.30, hd
         if hd != 90:
             assert abs(dp) <= 0.30, hd
-        if hd != 180:
+        if hd == 90:
             assert abs(dr) <= 0.35, hd
+        elif hd == 135:
+            assert 0.35 < dr <= 1.3, hd                              # the design lacks the lift (above)
 
 
 def test_missing_file_is_named(tmp_path):

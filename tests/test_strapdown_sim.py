@@ -9,7 +9,7 @@
 * a short record of patrol51 in a quartering sea (benchmarks/strapdown_sim.py, 200 s): roll of several
   degrees RMS reconstructed within the measured NRE (the mirror integration well under the FFT's), and
   the nonlinear scheme beats Miles' linearised
-  analysis (his claim) — by a factor > 2 on pitch.
+  analysis (his claim) — by a factor > 1.5 on pitch (measured 1.6–2.2 over seeds 1–4).
 Measured figures over longer records: benchmarks/results/strapdown_sim.json.
 """
 
@@ -99,9 +99,11 @@ def test_strapdown_on_a_short_simulated_record():
     S = _bench()
     # A record where the nonlinear (rotation) terms matter: T_p 5.5 s, the peak on patrol51's roll resonance
     # (1.14 rad/s since its stand-in hull was fitted to BC93's KM and its sway added mass made consistent
-    # with the wave excitation), seed 1: 9.4° RMS roll. Measured: roll NRE 3.4 % (mirror) vs 5.4 % (FFT);
-    # pitch NRE 3.5 % vs 8.2 % for the linear strapdown. The mirror integration's margin over the FFT one
-    # depends on the record (it is an end effect): same sea, seeds 2 and 4, 4.3 vs 4.9 % and 4.1 vs 4.3 %.
+    # with the wave excitation), seed 1: 8.5° RMS roll since the maneuvering forces see the waves' flow
+    # (9.4° before). Measured: roll NRE 6.0 % (mirror) vs 11.9 % (FFT); pitch NRE 4.9 % vs 9.7 % for the
+    # linear strapdown (1.95×; seeds 2–4: 2.2×, 1.8×, 1.6×, and 2.3× on this seed before the flow: the
+    # factor is the record's, hence > 1.5 here). The mirror integration's margin over the FFT one depends
+    # on the record (it is an end effect): same sea, seeds 2 and 4, 4.6 vs 5.4 % and 5.9 vs 5.8 %.
     # (Before, with the hull's roll excitation 2.4 times too stiff, T_p 7 s seed 3 rolled 10.5°; it now
     # rolls 5.2°.)
     rec = S.simulate_array(3.0, 5.5, 120.0, 10.0, 200.0, seed=1, n_components=60)
@@ -112,5 +114,5 @@ def test_strapdown_on_a_short_simulated_record():
     assert r["nre_roll_pct"] < 10.0 and r["nre_pitch_pct"] < 10.0 and r["nre_heave_pct"] < 20.0
     t = rec["t"]
     lin = strapdown_linear(np.linspace(t[0], t[-1], t.size), rec["acc"], AccelerometerArray(rec["offsets"], rec["axes"]), 0.04)
-    assert nre(lin[:, 1], rec["truth"]["pitch"]) > 2.0 * r["nre_pitch_pct"]
+    assert nre(lin[:, 1], rec["truth"]["pitch"]) > 1.5 * r["nre_pitch_pct"]
     assert nre(lin[:, 0], rec["truth"]["roll"]) > r["nre_roll_pct"]
