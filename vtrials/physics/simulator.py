@@ -76,8 +76,10 @@ class _Shard:
         return self.rec
 
 
-#: Component types of the sea (waves and their loads): left out of the calm-water steady states.
-SEA_COMPONENT_TYPES = ("radiation", "wave_excitation", "wave_drift", "wave_flow", "added_resistance")
+#: First-order (oscillating) wave component types: left out of the steady states, where a frozen value at
+#: one instant means nothing. Mean wave forces (wave_drift, added_resistance) stay in: a steady state in
+#: a seaway includes them (tests/test_added_resistance.py, tests/test_wave_drift.py).
+FIRST_ORDER_WAVE_TYPES = ("radiation", "wave_excitation", "wave_flow")
 
 
 @dataclasses.dataclass
@@ -630,16 +632,16 @@ class Simulator:
 
     # ------------------------------------------------------------------ steady states
     def _calm_twin(self, ship: int):
-        """(simulator, index) on which ship ``ship``'s calm-water steady states are solved: this one if it has
-        no sea components (:data:`SEA_COMPONENT_TYPES`), else a one-ship twin without them (same vessel, step,
-        limits and the ship's environment block), so that a frozen wave force at one instant does not enter
-        a calm-water balance."""
-        if not any(c.type in SEA_COMPONENT_TYPES for c in self.components):
+        """(simulator, index) on which ship ``ship``'s steady states are solved: this one if it has no
+        first-order wave components (:data:`FIRST_ORDER_WAVE_TYPES`), else a one-ship twin without them
+        (same vessel, step, limits, mean wave forces and the ship's environment block), so that a frozen
+        first-order wave force at one instant does not enter the balance."""
+        if not any(c.type in FIRST_ORDER_WAVE_TYPES for c in self.components):
             return self, ship
         if self._calm_sim is None:
             self._calm_sim = Simulator(self.vessel, 1, self.dt, envs=self.env[ship], record_every=0,
                                        limits=tuple(self.limits), planar=self.planar, gravity=self._gravity,
-                                       components=[c for c in self.components if c.type not in SEA_COMPONENT_TYPES])
+                                       components=[c for c in self.components if c.type not in FIRST_ORDER_WAVE_TYPES])
         self._calm_sim.env[0] = self.env[ship]
         return self._calm_sim, 0
 
