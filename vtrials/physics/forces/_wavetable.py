@@ -36,6 +36,21 @@ def heading_fold(cm, sm, cp, sp, dh, nbeta):
 
 
 @nb.njit(cache=True, inline="always")
+def ship_pose(ctx):
+    """(x north, y east [m] of the origin, time [s], cos ψ, sin ψ) from the context: where and when a wave
+    component's phase and relative heading are taken."""
+    psi = ctx[L.EUL + 2]
+    return ctx[L.POS], ctx[L.POS + 1], ctx[L.TIME], math.cos(psi), math.sin(psi)
+
+
+@nb.njit(cache=True, inline="always")
+def component_phase(p, q, x, y, t):
+    """θ = ω t − k (x cos μ + y sin μ) + ε of the wave component whose [a, ω, k, cos μ, sin μ, ε] start at
+    p[q] (:mod:`vtrials.physics.environment.waves`), at the ship's origin (x, y) at time t."""
+    return p[q + 1] * t - p[q + 2] * (x * p[q + 3] + y * p[q + 4]) + p[q + 5]
+
+
+@nb.njit(cache=True, inline="always")
 def lerp(p, k0, k1, fr):
     """(1 − fr) p[k0] + fr p[k1]."""
     return (1.0 - fr) * p[k0] + fr * p[k1]

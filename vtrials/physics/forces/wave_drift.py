@@ -22,7 +22,7 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.physics.forces import context as L
-from vtrials.physics.forces._wavetable import heading_fold, lerp
+from vtrials.physics.forces._wavetable import heading_fold, lerp, ship_pose
 from vtrials.physics.forces.registry import register
 
 
@@ -58,9 +58,7 @@ def drift_kernel(p, s, env, ctx, aux, w):
     dh = p[3] - p[2]
     base = 2 + nbeta
     stride = 3 + 3 * nbeta
-    psi = ctx[L.EUL + 2]
-    cp = math.cos(psi)
-    sp = math.sin(psi)
+    _, _, _, cp, sp = ship_pose(ctx)
     fx = 0.0
     fy = 0.0
     mz = 0.0

@@ -26,8 +26,7 @@ import numba as nb
 import numpy as np
 
 from vtrials.errors import InputError
-from vtrials.physics.forces import context as L
-from vtrials.physics.forces._wavetable import heading_fold, lerp, seakeeping_to_body
+from vtrials.physics.forces._wavetable import component_phase, heading_fold, lerp, seakeeping_to_body, ship_pose
 from vtrials.physics.forces.registry import register
 
 HEAD = 8
@@ -76,22 +75,15 @@ def excitation_kernel(p, s, env, ctx, aux, w):
     dh = p[h0 + 1] - p[h0]
     base = h0 + nbeta
     stride = 6 + 12 * nbeta
-    x = ctx[L.POS]
-    y = ctx[L.POS + 1]
-    t = ctx[L.TIME]
-    psi = ctx[L.EUL + 2]
-    cp = math.cos(psi)
-    sp = math.sin(psi)
+    x, y, t, cp, sp = ship_pose(ctx)
     # the six sums in registers (w is written once): the same additions in the same order
     f0 = f1 = f2 = f3 = f4 = f5 = 0.0
     for c in range(n):
         q = base + c * stride
         a = p[q]
-        om = p[q + 1]
-        k = p[q + 2]
         cm = p[q + 3]
         sm = p[q + 4]
-        th = om * t - k * (x * cm + y * sm) + p[q + 5]
+        th = component_phase(p, q, x, y, t)
         ct = a * math.cos(th)
         st = a * math.sin(th)
         i0, fr, sgn = heading_fold(cm, sm, cp, sp, dh, nbeta)   # β = μ − ψ, folded

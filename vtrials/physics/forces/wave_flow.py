@@ -39,6 +39,7 @@ import numpy as np
 
 from vtrials.errors import InputError
 from vtrials.physics.forces import context as L
+from vtrials.physics.forces._wavetable import component_phase, ship_pose
 from vtrials.physics.forces.registry import register
 
 HEAD = 3
@@ -83,12 +84,7 @@ def flow_kernel(p, s, env, ctx, aux, w):
     n = int(p[0])
     half = 0.5 * p[1]
     d = p[2]
-    x = ctx[L.POS]
-    y = ctx[L.POS + 1]
-    t = ctx[L.TIME]
-    psi = ctx[L.EUL + 2]
-    cp = math.cos(psi)
-    sp = math.sin(psi)
+    x, y, t, cp, sp = ship_pose(ctx)
     vw = 0.0
     rw = 0.0
     fw = 0.0
@@ -99,7 +95,7 @@ def flow_kernel(p, s, env, ctx, aux, w):
         k = p[q + 2]
         cm = p[q + 3]
         sm = p[q + 4]
-        th = om * t - k * (x * cm + y * sm) + p[q + 5]
+        th = component_phase(p, q, x, y, t)
         sb = sm * cp - cm * sp           # sin β, β = μ − ψ
         kap = k * (cm * cp + sm * sp)    # k cos β
         z = kap * half
