@@ -20,7 +20,8 @@ H_s,fused = r H_s,radar (seed 004 eqs. 1-5). Scored against the true sea's H_s (
     before the leg acceptance and the ship-buoy columns were added)
 
 Writes the JSON after every case, so a partial campaign is kept. Each leg is also reduced by the ship as
-a wave buoy (vtrials.reduce.shipbuoy, same design RAOs, no radar). Legs whose gyro heading wandered more
+a wave buoy (vtrials.reduce.shipbuoy, same design RAOs, no radar): leg by leg ("buoy") and as one sea
+fitted to all the case's legs ("star_buoy", ship_buoy_from_legs: the legs' headings tell the side). Legs whose gyro heading wandered more
 than MAX_HEADING_STD_DEG are summarised apart ("accepted_legs") — a records-only test.
 """
 
@@ -39,7 +40,7 @@ import numpy as np
 from vtrials.records.netcdf import open_record, read_groups
 from vtrials.reduce.design_rao import load_design_rao
 from vtrials.reduce.seamotion import run_windows
-from vtrials.reduce.shipbuoy import ship_buoy_from_record
+from vtrials.reduce.shipbuoy import ship_buoy_from_legs, ship_buoy_from_record
 from vtrials.reduce.wavefusion import fuse_run
 from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 from vtrials.scenario import load_scenario, wave_field
@@ -139,18 +140,36 @@ def reduce_case(out: Path, scn, design, legs=LEGS) -> list[dict]:
                "roll_std_true_deg": math.degrees(float(np.std(tr["roll"][k])))}
         try:   # the ship as a wave buoy on the same leg (the design RAOs, no radar)
             rb = ship_buoy_from_record(rec, t0, t1, design)
-            d = math.degrees(math.remainder(math.radians(rb.from_relative_deg - st["from_rel_deg"]), 2 * math.pi))
-            row["buoy"] = {"hs_err": rb.fit.hs / st["hs"] - 1.0, "from_rel_deg": rb.from_relative_deg, "dir_err_deg": d,
-                           "side_right": bool(abs(st["from_rel_deg"]) < 10.0 or abs(st["from_rel_deg"]) > 170.0
-                                              or np.sign(rb.from_relative_deg) == np.sign(st["from_rel_deg"])),
-                           "tp": rb.fit.tp, "s": rb.fit.s, "gamma": rb.fit.gamma,
-                           "observed": list(rb.observed), "reliable": rb.reliable}
+            row["buoy"] = scored(rb.fit, rb.from_relative_deg, st) | {"observed": list(rb.observed),
+                                                                       "reliable": rb.reliable}
         except Exception as exc:  # reported, not hidden
             row["buoy"] = {"error": f"{type(exc).__name__}: {exc}"[:200]}
+        row["_truth"] = st
         rows.append(row)
         print(json.dumps({c: row[c] for c in ("seed", "run", "leg", "hs_true", "radar_ratio", "heading_std_deg")}
                          | {"heave+pitch": round(row["fused_ratio"]["heave+pitch"], 3)}), flush=True)
+    try:   # one sea fitted to all the star's legs: the headings tell port from starboard
+        sb = ship_buoy_from_legs(rec, [(t0, t1) for _, t0, t1 in run_windows(rec)], design)
+        for k, row in enumerate(rows):
+            row["star_buoy"] = scored(sb.fit, sb.from_relative_deg(k), row["_truth"]) | {
+                "observed": list(sb.observed[k]), "reliable": sb.reliable(k), "side_from": sb.side_from,
+                "roll_tuning": list(sb.fit.roll)}
+    except Exception as exc:  # reported, not hidden
+        for row in rows:
+            row["star_buoy"] = {"error": f"{type(exc).__name__}: {exc}"[:200]}
+    for row in rows:
+        del row["_truth"]
     return rows
+
+
+def scored(fit, from_rel_deg: float, st: dict) -> dict:
+    """A ship-as-buoy estimate against the leg's true sea: H_s error, direction error [deg], side right (a
+    sea within 10° of head or following seas has no side)."""
+    d = math.degrees(math.remainder(math.radians(from_rel_deg - st["from_rel_deg"]), 2 * math.pi))
+    return {"hs_err": fit.hs / st["hs"] - 1.0, "from_rel_deg": from_rel_deg, "dir_err_deg": d,
+            "side_right": bool(abs(st["from_rel_deg"]) < 10.0 or abs(st["from_rel_deg"]) > 170.0
+                               or np.sign(from_rel_deg) == np.sign(st["from_rel_deg"])),
+            "tp": fit.tp, "s": fit.s, "gamma": fit.gamma}
 
 
 def summary(rows) -> dict:
@@ -172,19 +191,25 @@ def _summary(rows) -> dict:
         out["combos"][c] = {"mean": float(np.mean(f)), "std": sd, "scatter_reduction": out["radar_ratio_std"] / sd,
                             "within_15pct_above_2.5m": int(np.sum((np.abs(f - 1) <= 0.15) & (hs > 2.5))),
                             "within_15pct_all": int(np.sum(np.abs(f - 1) <= 0.15))}
-    b_all = [r["buoy"] for r in rows if "hs_err" in r.get("buoy", {})]
-    for key, b in (("ship_buoy", b_all), ("ship_buoy_reliable", [x for x in b_all if x.get("reliable")]),
-                   ("ship_buoy_flagged", [x for x in b_all if not x.get("reliable", True)])):
-        if not b:
-            continue
-        he = np.array([x["hs_err"] for x in b])
-        de = np.array([abs(x["dir_err_deg"]) for x in b])
-        out[key] = {"n": len(b), "hs_within_15pct": int(np.sum(np.abs(he) <= 0.15)),
-                    "dir_within_15deg": int(np.sum(de <= 15.0)), "side_right": int(sum(x["side_right"] for x in b)),
-                    "both": int(np.sum((np.abs(he) <= 0.15) & (de <= 15.0))),
-                    "hs_err_mean": float(np.mean(he)), "hs_abs_err_median": float(np.median(np.abs(he))),
-                    "dir_abs_err_median_deg": float(np.median(de))}
+    for name in ("buoy", "star_buoy"):
+        b_all = [r[name] for r in rows if "hs_err" in r.get(name, {})]
+        pre = "ship_buoy" if name == "buoy" else "star_buoy"
+        for key, b in ((pre, b_all), (pre + "_reliable", [x for x in b_all if x.get("reliable")]),
+                       (pre + "_flagged", [x for x in b_all if not x.get("reliable", True)])):
+            if b:
+                out[key] = _buoy_summary(b)
     return out
+
+
+def _buoy_summary(b) -> dict:
+    """Counts of ship-as-buoy results within 15 % in H_s, within 15° in direction, on the right side."""
+    he = np.array([x["hs_err"] for x in b])
+    de = np.array([abs(x["dir_err_deg"]) for x in b])
+    return {"n": len(b), "hs_within_15pct": int(np.sum(np.abs(he) <= 0.15)),
+            "dir_within_15deg": int(np.sum(de <= 15.0)), "side_right": int(sum(x["side_right"] for x in b)),
+            "both": int(np.sum((np.abs(he) <= 0.15) & (de <= 15.0))),
+            "hs_err_mean": float(np.mean(he)), "hs_abs_err_median": float(np.median(np.abs(he))),
+            "dir_abs_err_median_deg": float(np.median(de)), "dir_abs_err_max_deg": float(np.max(de))}
 
 
 def main(argv=None) -> dict:

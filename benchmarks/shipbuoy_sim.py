@@ -8,7 +8,9 @@ only (IMU specific forces and vertical-gyro roll/pitch -> heave at the IMU, roll
 fit with the team's DESIGN-STAGE RAOs, models/patrol51/design) and is scored against the true sea
 (vtrials.truth.seaway: the components' H_s, their energy-weighted mean direction relative to the
 ship's true mean heading over the run). Three fit settings are reported: roll stiffness and damping
-fitted with the sea (the default), roll RAO trusted as the design model has it, and roll with a free gain.
+fitted with the sea (the default), roll RAO trusted as the design model has it, and roll with a free gain;
+and ("day_fit") one sea fitted to the day's four runs together (reduce.shipbuoy.ship_buoy_from_legs): on
+reciprocal courses the headings cannot tell port from starboard, so there roll still does.
 
     PYTHONPATH=. python benchmarks/shipbuoy_sim.py [--quick]
 
@@ -31,7 +33,7 @@ import numpy as np
 from vtrials.records.netcdf import open_record, read_groups
 from vtrials.reduce.design_rao import load_design_rao
 from vtrials.reduce.seamotion import run_windows
-from vtrials.reduce.shipbuoy import ship_buoy_from_record
+from vtrials.reduce.shipbuoy import ship_buoy_from_legs, ship_buoy_from_record
 from vtrials.runner.trial_day import simulate_agenda, write_agenda_outputs
 from vtrials.scenario import load_scenario, wave_field
 from vtrials.truth.seaway import sea_truth, window_heading
@@ -76,14 +78,27 @@ def score_case(out: Path, scn, design, settings=SETTINGS) -> list[dict]:
                          "observed": list(rb.observed), "reliable": rb.reliable,
                          "side_right": bool(np.sign(rb.from_relative_deg) == np.sign(st["from_rel_deg"])),
                          "seconds": time.perf_counter() - t}
+        row["_truth"] = st
         rows.append(row)
+    # one sea fitted to the day's four runs: reciprocal courses, so roll (not the headings) tells the side
+    t = time.perf_counter()
+    sb = ship_buoy_from_legs(rec, [(t0, t1) for _, t0, t1 in run_windows(rec)], design)
+    for k, row in enumerate(rows):
+        st = row.pop("_truth")
+        d = math.remainder(math.radians(sb.from_relative_deg(k) - st["from_rel_deg"]), 2 * math.pi)
+        row["day_fit"] = {"hs": sb.fit.hs, "hs_err": sb.fit.hs / st["hs"] - 1.0, "from_rel_deg": sb.from_relative_deg(k),
+                          "dir_err_deg": math.degrees(d), "tp": sb.fit.tp, "s": sb.fit.s, "gamma": sb.fit.gamma,
+                          "roll_tuning": list(sb.fit.roll), "side_from": sb.side_from,
+                          "observed": list(sb.observed[k]), "reliable": sb.reliable(k),
+                          "side_right": bool(np.sign(sb.from_relative_deg(k)) == np.sign(st["from_rel_deg"])),
+                          "seconds": time.perf_counter() - t}
         print(json.dumps(row), flush=True)
     return rows
 
 
 def summary(rows, settings=SETTINGS) -> dict:
     out = {}
-    for name in settings:
+    for name in tuple(settings) + ("day_fit",):
         for tag, sel in (("", rows), ("_reliable", [r for r in rows if r[name].get("reliable")]),
                          ("_flagged", [r for r in rows if not r[name].get("reliable", True)])):
             if not sel:

@@ -140,3 +140,72 @@ def test_roll_tuning_recovers_a_mistuned_roll():
     assert fit.roll[1] == pytest.approx(0.06, abs=0.02)
     with pytest.raises(InputError, match="roll part"):
         fit_directional_spectrum(ResponseModel(omega, mu, R, U, G.omega[band]), G.S[band], tune_roll=True)
+
+
+class _RollPhase:
+    """The synthetic ship with its roll RAO turned by ``deg`` degrees: a ship whose roll leads the team's
+    model by about as much as patrol51's does at 9 m/s in bow seas (60–105°, the waves' flow in its lift)."""
+
+    def __init__(self, ship, deg):
+        self.ship, self.turn = ship, np.exp(1j * math.radians(deg))
+
+    def rao(self, omega, mu, U):
+        R = self.ship.rao(omega, mu, U)
+        R[2] = R[2] * self.turn
+        return R
+
+
+def test_legs_on_different_headings_tell_port_from_starboard():
+    """A star pattern in one sea (from 080°, H_s 3 m, T_p 9 s, s = 10): head (080), starboard bow (040) and
+    port bow (125) legs of 25 min at 6 m/s, by a ship whose roll phase is 100° off the team's model.
+    Leg by leg only roll tells the side, and this roll misleads (the precondition: both bow legs' single
+    fits more than 30° off; measured 43° and 50°, pulled towards head seas). One sea fitted to the three
+    legs (fit_legs, the legs' headings) finds it on every leg: H_s within 15 %, direction within 10° —
+    with roll (measured −8 %, 2.4°) and without it (heave and pitch alone, whose mirror images disagree
+    between headings: −3 %, 4.0°). Legs on reciprocal courses
+    cannot tell the side by their headings (side_evidence)."""
+    from vtrials.reduce.shipbuoy import fit_legs, side_evidence
+    rng = np.random.default_rng(11)
+    field = realize(Waves(hs_m=3.0, tp_s=9.0, direction_deg=80.0, spreading_s=10.0, n_components=400),
+                    math.inf, rng)
+    true_ship = _RollPhase(SHIP, 100.0)
+    mu_true, _ = field.bulk_direction()                           # towards, from north
+    headings = [math.radians(h) for h in (80.0, 40.0, 125.0)]
+    omega = np.linspace(0.2, 2.5, 200)
+    mu = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+    W, M = np.meshgrid(omega, mu, indexing="ij")
+    R = SHIP.rao(W, M, U)
+    data = {}
+    for k, hd in enumerate(headings):
+        t = 1800.0 * k + np.arange(0.0, 1500.0, 1.0 / FS)
+        rec = responses(true_ship, field.components, hd, U, t)
+        rec = rec + 0.02 * rec.std(axis=1, keepdims=True) * rng.standard_normal(rec.shape)
+        G = cross_spectral_matrix(rec, FS, 256)
+        band = (G.omega >= 0.15) & (G.omega <= 2.0)
+        data[k] = (G.omega[band], G.S[band])
+
+    def err(fit_mu0, hd):
+        return math.degrees(abs(math.remainder(fit_mu0 - (mu_true - hd), 2 * math.pi)))
+
+    single = []
+    for k, hd in enumerate(headings):
+        f = fit_directional_spectrum(ResponseModel(omega, mu, R, U, data[k][0]), data[k][1])
+        single.append(err(f.mu0, hd))
+    print(f"leg by leg (heave, pitch, roll): direction errors {np.round(single, 1)}°")
+    assert min(single[1:]) > 30.0                                 # roll misleads both bow legs
+    for rows, label in (([0, 1, 2], "heave, pitch, roll"), ([0, 1], "heave, pitch")):
+        models = [ResponseModel(omega, mu, R[rows], U, data[k][0]) for k in data]
+        G_meas = [data[k][1][:, rows][:, :, rows] for k in data]
+        fit = fit_legs(models, G_meas, headings)
+        errs = [err(fit.mu0 - hd, hd) for hd in headings]
+        print(f"one sea on three legs ({label}): H_s {fit.hs:.2f} vs {field.hs_realized_m:.2f} m, "
+              f"from {math.degrees(fit.direction_from(0.0)):.1f}° (true 80), direction errors {np.round(errs, 1)}°")
+        assert fit.hs == pytest.approx(field.hs_realized_m, rel=0.15)
+        assert max(errs) < 10.0
+        assert len(fit.G_pred) == 3
+    assert side_evidence(headings, ("heave", "pitch")) == "headings"
+    recip = [headings[1], headings[1] + math.pi]
+    assert side_evidence(recip, ("heave", "pitch")) == "none"
+    assert side_evidence(recip, ("heave", "roll", "pitch")) == "roll"
+    with pytest.raises(InputError, match="one of each per leg"):
+        fit_legs(models, G_meas, headings[:2])

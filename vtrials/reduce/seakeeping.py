@@ -48,6 +48,7 @@ import math
 import numpy as np
 from scipy import stats
 
+from vtrials.errors import InputError
 from vtrials.records.netcdf import Record
 from vtrials.reduce import encounter as ENC
 from vtrials.reduce import heave as HV
@@ -212,4 +213,97 @@ def reduce_seakeeping(rec: Record) -> dict:
     else:
         for run in sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"]):
             legs.append(reduce_leg(rec, run, kinds))
-    return {"kind": "seakeeping", "legs": legs, "notes": notes, "coherence_min": COHERENCE_MIN}
+    out = {"kind": "seakeeping", "legs": legs, "notes": notes, "coherence_min": COHERENCE_MIN}
+    out["ship_buoy"] = ship_buoy_block(rec, kinds, notes)
+    out["wave_fusion"] = wave_fusion_block(rec, kinds, notes)
+    return out
+
+
+#: Shortest leg the ship-as-buoy fit takes: two of its 128-s Welch segments.
+BUOY_MIN_LEG_S = 256.0
+
+#: Motion components fused with the wave radar in a seakeeping trial's reduction (seed 004 compares each
+#: component and pair; heave + pitch gave its headline).
+FUSION_COMBOS = (("heave", "pitch"), ("heave",), ("pitch",))
+
+
+def _motion_roles(rec: Record, kinds: dict, notes: list, what: str):
+    """(instrument names by run_motions' role, the team's design-stage RAO model, accepted runs) or None
+    with a note naming what is missing."""
+    from vtrials.reduce.design_rao import load_design_rao
+    need = {"imu": "imu", "attitude": "attitude", "log": "em_log", "compass": "heading"}
+    missing = [k for k in need.values() if not kinds.get(k)]
+    runs = sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"])
+    if missing or not runs:
+        notes.append(f"no {what}: the record has no {', '.join(missing) or 'accepted leg'}")
+        return None
+    ship = rec.team.get("ship", "")
+    try:
+        design = load_design_rao(ship)
+    except InputError as exc:
+        notes.append(f"no {what}: no design-stage RAO model for {ship!r} ({exc})")
+        return None
+    return {k: kinds[v][0] for k, v in need.items()}, design, runs
+
+
+def wave_fusion_block(rec: Record, kinds: dict, notes: list) -> dict | None:
+    """Seed 004's wave fusion per accepted leg (a leg the radar has no spectrum in is left out, noted) (:func:`vtrials.reduce.wavefusion.fuse_run`: the wave radar's
+    H_s scaled by measured over predicted motion RMS through the team's design-stage RAOs) for
+    :data:`FUSION_COMBOS`, or None (with a note when a radar is aboard but the rest is missing)."""
+    from vtrials.reduce.wavefusion import fuse_run
+    radars = kinds.get("wave_radar") or []
+    if not radars:
+        return None
+    got = _motion_roles(rec, kinds, notes, "wave fusion")
+    if got is None:
+        return None
+    names, design, runs = got
+    legs = []
+    for r in runs:
+        try:
+            f = fuse_run(rec, float(r["t_execute"]), float(r["t_finex"]), design, combos=FUSION_COMBOS,
+                         radar=radars[0], instruments=names)
+        except InputError as exc:          # e.g. a leg shorter than one radar acquisition
+            notes.append(f"run {r['run']}: no wave fusion ({exc})")
+            continue
+        legs.append({"run": r["run"], "label": r["label"], "hs_radar": f.hs_radar, "n_spectra": f.n_spectra,
+                     "measured_rms": f.measured, "predicted_rms": f.predicted,
+                     "r": {k: v.r for k, v in f.fused.items()}, "hs_fused": {k: v.hs for k, v in f.fused.items()},
+                     "heading_std_deg": math.degrees(f.heading_std)})
+    if not legs:
+        return None
+    return {"method": "seed 004 eqs. 1-5: H_s = r H_s,radar, r = mean of measured/predicted motion RMS "
+                      "(reduce.wavefusion.fuse_run)", "radar": radars[0],
+            "design_file": f"models/{rec.team.get('ship', '')}/design/{rec.team.get('ship', '')}_design_rao.nc",
+            "combos": ["+".join(c) for c in FUSION_COMBOS], "legs": legs}
+
+
+def ship_buoy_block(rec: Record, kinds: dict, notes: list) -> dict | None:
+    """The ship as a wave buoy over the trial's accepted legs (:func:`vtrials.reduce.shipbuoy.ship_buoy_from_legs`:
+    one sea fitted to all legs' heave, roll and pitch with the team's design-stage RAOs, models/<ship>/design),
+    or None with a note when the record lacks the motion sensors, the log or the compass, or the team has no
+    design model for the ship."""
+    from vtrials.reduce.shipbuoy import ship_buoy_from_legs
+    got = _motion_roles(rec, kinds, notes, "ship-as-buoy estimate")
+    if got is None:
+        return None
+    names, design, runs = got
+    ship = rec.team.get("ship", "")
+    short = [r for r in runs if float(r["t_finex"]) - float(r["t_execute"]) < BUOY_MIN_LEG_S]
+    if short:
+        notes.append(f"ship as a wave buoy: runs {', '.join(str(r['run']) for r in short)} shorter than "
+                     f"{BUOY_MIN_LEG_S:.0f} s (two Welch segments) left out")
+    runs = [r for r in runs if r not in short]
+    if not runs:
+        return None
+    windows = [(float(r["t_execute"]), float(r["t_finex"])) for r in runs]
+    sb = ship_buoy_from_legs(rec, windows, design, instruments=names)
+    f = sb.fit
+    return {"method": "one sea (JONSWAP, free gamma; cos-2s) fitted to every leg's heave/roll/pitch cross-spectra, "
+                      "roll stiffness and damping tuned (reduce.shipbuoy.ship_buoy_from_legs)",
+            "design_file": f"models/{ship}/design/{ship}_design_rao.nc", "components": list(sb.components),
+            "hs": f.hs, "tp": f.tp, "gamma": f.gamma, "s": f.s, "from_deg": sb.from_deg,
+            "roll_tuning": list(f.roll), "side_from": sb.side_from,
+            "legs": [{"run": r["run"], "label": r["label"], "heading": sb.headings[k], "U": sb.U[k],
+                      "from_rel_deg": sb.from_relative_deg(k), "observed": list(sb.observed[k]),
+                      "reliable": sb.reliable(k)} for k, r in enumerate(runs)]}

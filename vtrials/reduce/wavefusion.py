@@ -115,21 +115,22 @@ def radar_window(record, t0: float, t1: float, radar: str = "radar"):
 
 
 def fuse_run(record, t0: float, t1: float, design, combos=(("heave", "pitch"),), radar: str = "radar",
-             omega_c: float = 0.25, fs: float = 2.0) -> RunFusion:
+             omega_c: float = 0.25, fs: float = 2.0, instruments: dict | None = None) -> RunFusion:
     """Seed 004's fusion for one run from its record (module doc): the radar's mean directional spectrum
     over the run, turned into the ship's frame with the gyro heading, predicts each motion component's RMS
     through the team's design RAOs (``design``, :class:`vtrials.reduce.design_rao.DesignRAO`) at the run's
     mean log speed; the record gives the measured RMS (:func:`vtrials.reduce.seamotion.run_motions`).
     The heave prediction carries the same high-pass (``omega_c`` on the encounter frequency, half-cosine
     from ω_c/2) as the double integration that measures it. ``combos``: tuples of 'heave', 'pitch', 'roll',
-    'acc' (vertical acceleration at the IMU) fused together (r = mean of their ratios)."""
+    'acc' (vertical acceleration at the IMU) fused together (r = mean of their ratios). ``instruments``:
+    the record's instrument names by run_motions' role (imu, attitude, log, compass) where not the default."""
     from vtrials.reduce.seamotion import design_responses, run_motions
 
     bad = sorted({c for combo in combos for c in combo} - set(COMPONENTS))
     if bad or not combos or any(len(c) == 0 for c in combos):
         raise InputError("record", "combos", f"{bad or list(combos)}: each combination is a non-empty tuple of "
                          f"motion components; allowed heave, roll, pitch, acc")
-    mot = run_motions(record, t0, t1, fs_out=fs, omega_c=omega_c)
+    mot = run_motions(record, t0, t1, fs_out=fs, omega_c=omega_c, **(instruments or {}))
     w, mu_to, S, hs_r, n = radar_window(record, t0, t1, radar)
     mu_rel = mu_to - mot.heading
     W, M = np.meshgrid(w, mu_rel, indexing="ij")

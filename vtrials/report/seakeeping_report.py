@@ -78,8 +78,12 @@ def figures(tr: dict, out: Path) -> list[str]:
             ax.annotate("", xy=(leg["heading"], 2.4), xytext=(0, 0),
                         arrowprops={"arrowstyle": "->", "color": "C3", "lw": 1.0})
             ax.text(leg["heading"], 2.55, str(leg["run"]), color="C3", fontsize=8)
+    sb = tr["reduced"].get("ship_buoy")
+    if sb:
+        ax.plot([math.radians(sb["from_deg"])] * 2, [0.0, 2.5], "C1-", lw=2.0)
+        ax.text(math.radians(sb["from_deg"]), 2.7, "ship as buoy", color="C1", fontsize=8)
     ax.set_title("true directional spectrum (waves coming from; radius ω [rad/s])\nred: the legs' courses "
-                 "(gyro)", fontsize=9)
+                 "(gyro)" + ("; orange: the ship-as-buoy mean direction" if sb else ""), fontsize=9)
     ax = fig.add_subplot(1, 2, 2, projection="polar")
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
@@ -109,6 +113,22 @@ def figures(tr: dict, out: Path) -> list[str]:
     ax.set_ylabel("reduced / true")
     ax.legend(fontsize=7)
     names.append(_save(fig, out, "seakeeping_rms.png"))
+    wf = tr.get("wave_fusion")
+    if wf and wf["legs"]:
+        # seed 004's fusion scatter, per leg: the radar's H_s and the fused ones over the true sea's
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        x = np.arange(len(wf["legs"]))
+        ax.plot(x, [L["radar_ratio"] for L in wf["legs"]], "ks", label="radar")
+        for k, (c, mk) in enumerate(zip(tr["reduced"]["wave_fusion"]["combos"], "o^v")):
+            ax.plot(x, [L["fused_ratio"][c] for L in wf["legs"]], mk, color=f"C{k}", label=f"fused, {c}")
+        ax.axhspan(0.85, 1.15, color="0.9")
+        ax.axhline(1.0, color="k", lw=0.6)
+        ax.set_xticks(x, [str(L["run"]) for L in wf["legs"]])
+        ax.set_xlabel("run")
+        ax.set_ylabel("H_s / true H_s")
+        ax.legend(fontsize=7)
+        ax.set_title("wave fusion (seed 004): radar H_s and radar × measured/predicted motion RMS", fontsize=9)
+        names.append(_save(fig, out, "seakeeping_fusion.png"))
     return names
 
 
@@ -136,6 +156,58 @@ def markdown(tr: dict, figs: list[str]) -> list[str]:
                  f"{_fmt(math.degrees(rm['pitch']['reduced']))} ({_fmt(math.degrees(rm['pitch']['truth']))}) | "
                  + "/".join(str(sc["transfer"][n]["bins"]) for n in ("heave", "vertical_acc", "roll", "pitch")) + " |")
     L.append("")
+    L += ship_buoy_markdown(tr)
+    L += wave_fusion_markdown(tr)
     L += [f"![{f}]({f})" for f in figs]
+    L.append("")
+    return L
+
+
+def wave_fusion_markdown(tr: dict) -> list[str]:
+    """Seed 004's wave fusion per leg: the radar's and the fused H_s against the true sea's."""
+    wf, sc = tr["reduced"].get("wave_fusion"), tr.get("wave_fusion")
+    if not wf or not sc:
+        return []
+    combos = wf["combos"]
+    L = ["### Wave fusion (seed 004)", "",
+         f"The wave radar (`{wf['radar']}`) H_s times r, the mean of measured over predicted motion RMS "
+         f"(design-stage RAOs, `{wf['design_file']}`); true H_s {sc['hs_true']:.3f} m.", "",
+         "| run | leg | radar / true | " + " | ".join(f"{c} / true" for c in combos) + " |",
+         "|---|---|---|" + "---|" * len(combos)]
+    for leg in sc["legs"]:
+        L.append(f"| {leg['run']} | {leg['label']} | {leg['radar_ratio']:.3f} | "
+                 + " | ".join(f"{leg['fused_ratio'][c]:.3f}" for c in combos) + " |")
+    s = sc["summary"]
+    if s:
+        L += ["", "| | mean | std | std radar / std | within 15 % |", "|---|---|---|---|---|",
+              f"| radar | {s['radar']['mean']:.3f} | {s['radar']['std']:.3f} | | {s['radar']['within_15pct']} |"]
+        L += [f"| {c} | {s[c]['mean']:.3f} | {s[c]['std']:.3f} | {s[c]['scatter_reduction']:.1f} | {s[c]['within_15pct']} |"
+              for c in combos]
+    L.append("")
+    return L
+
+
+def ship_buoy_markdown(tr: dict) -> list[str]:
+    """The ship as a wave buoy: the one sea fitted to all legs against the true sea, per leg."""
+    sb, sc = tr["reduced"].get("ship_buoy"), tr.get("ship_buoy")
+    if not sb or not sc:
+        return []
+    tune = sb["roll_tuning"]
+    L = ["### The ship as a wave buoy", "",
+         f"One sea fitted to every leg's heave, roll and pitch with the team's design-stage RAOs "
+         f"(`{sb['design_file']}`): H_s {sb['hs']:.3f} m (true {tr['truth']['hs']:.3f} m), T_p {sb['tp']:.2f} s, "
+         f"γ {sb['gamma']:.2f}, s {sb['s']:.1f}, from {sb['from_deg']:.1f}° (gyro north); port and starboard told by "
+         f"the {sb['side_from']}" + (f"; roll stiffness {100 * tune[0]:+.0f} %, damping {100 * tune[1]:+.1f} % of "
+                                     f"critical from the design's" if tune else "") + ".", "",
+         "| run | leg | waves from (true) [° off the bow] | direction error [°] | side | reliable |",
+         "|---|---|---|---|---|---|"]
+    for leg in sc["legs"]:
+        L.append(f"| {leg['run']} | {leg['label']} | {leg['from_rel_deg']:+.1f} ({leg['from_rel_true_deg']:+.1f}) | "
+                 f"{leg['dir_error_deg']:+.1f} | {'right' if leg['side_right'] else 'WRONG'} | "
+                 f"{'yes' if leg['reliable'] else 'no'} |")
+    for key, s in sc["summary"].items():
+        L.append("")
+        L.append(f"{key} legs ({s['legs']}): H_s within 15 % on {s['hs_within_15pct']}, direction within 15° on "
+                 f"{s['dir_within_15deg']}, side right on {s['side_right']}.")
     L.append("")
     return L

@@ -268,8 +268,70 @@ def score_seakeeping(reduced: dict, res, name: str) -> dict:
             summary[n] = {"bins": len(errs), "median_abs_amp_error": float(np.median(a)), "max_abs_amp_error": float(a.max()),
                           "within_10pct": float(np.mean(a <= 0.10)), "expected_within_10pct": float(ew),
                           "amp_coverage": float(np.mean(cov)), "phase_coverage": float(np.mean(pcov))}
-    return {"reduced": reduced, "truth": {"hs": hs_true, "directional_spectrum": directional_spectrum(comp)},
-            "legs": legs, "summary": summary}
+    out = {"reduced": reduced, "truth": {"hs": hs_true, "directional_spectrum": directional_spectrum(comp)},
+           "legs": legs, "summary": summary}
+    if reduced.get("ship_buoy"):
+        out["ship_buoy"] = score_ship_buoy(reduced["ship_buoy"], comp, truth)
+    if reduced.get("wave_fusion"):
+        out["wave_fusion"] = score_wave_fusion(reduced["wave_fusion"], comp)
+    return out
+
+
+def score_wave_fusion(wf: dict, comp: np.ndarray) -> dict:
+    """Seed 004's comparison on one trial: per leg the radar's and each fused H_s over the sea's
+    (:func:`vtrials.truth.seaway.sea_truth`); over the legs the standard deviation of each ratio, the
+    radar's over the fused one (seed 004's scatter reduction) and the legs within 15 % of the truth."""
+    from vtrials.truth.seaway import sea_truth
+    hs = sea_truth(comp)["hs"]
+    legs = [{"run": L["run"], "label": L["label"], "hs_true": hs, "radar_ratio": L["hs_radar"] / hs,
+             "fused_ratio": {k: v / hs for k, v in L["hs_fused"].items()}} for L in wf["legs"]]
+    summary = {}
+    if legs:
+        rad = np.array([L["radar_ratio"] for L in legs])
+        sd_r = float(np.std(rad, ddof=1)) if rad.size > 1 else float("nan")
+        summary["radar"] = {"mean": float(np.mean(rad)), "std": sd_r, "within_15pct": int(np.sum(np.abs(rad - 1) <= 0.15))}
+        for k in wf["combos"]:
+            f = np.array([L["fused_ratio"][k] for L in legs])
+            sd = float(np.std(f, ddof=1)) if f.size > 1 else float("nan")
+            summary[k] = {"mean": float(np.mean(f)), "std": sd, "scatter_reduction": sd_r / sd if sd > 0 else float("nan"),
+                          "within_15pct": int(np.sum(np.abs(f - 1) <= 0.15))}
+    return {"hs_true": hs, "legs": legs, "summary": summary}
+
+
+#: Acceptance of a ship-as-buoy estimate (issue 13): H_s within 15 %, mean direction within 15°.
+BUOY_HS_TOL, BUOY_DIR_TOL_DEG = 0.15, 15.0
+
+
+def score_ship_buoy(sb: dict, comp: np.ndarray, truth: dict) -> dict:
+    """The ship-as-buoy sea (:func:`vtrials.reduce.seakeeping.ship_buoy_block`) against the true sea, per leg:
+    H_s against the components' (:func:`vtrials.truth.seaway.sea_truth`), the direction the waves come from
+    relative to the bow against the components' mean direction relative to the leg's true mean heading,
+    and the side (port/starboard; legs whose true waves are within 10° of the bow–stern line have none).
+    Summaries over all legs and over the legs flagged reliable."""
+    from vtrials.truth.seaway import sea_truth
+    legs = []
+    for leg in sb["legs"]:
+        ref = truth.get(leg["run"])
+        if ref is None:
+            continue
+        st = sea_truth(comp, ref["heading"])
+        d = math.degrees(math.remainder(math.radians(leg["from_rel_deg"] - st["from_rel_deg"]), 2 * math.pi))
+        true_rel = st["from_rel_deg"]
+        legs.append({"run": leg["run"], "label": leg["label"], "reliable": leg["reliable"], "hs_true": st["hs"],
+                     "hs_error": sb["hs"] / st["hs"] - 1.0, "from_rel_true_deg": true_rel,
+                     "from_rel_deg": leg["from_rel_deg"], "dir_error_deg": d,
+                     "side_right": bool(abs(true_rel) < 10.0 or abs(true_rel) > 170.0
+                                        or math.copysign(1.0, leg["from_rel_deg"]) == math.copysign(1.0, true_rel))})
+    summary = {}
+    for key, sel in (("all", legs), ("reliable", [L for L in legs if L["reliable"]])):
+        if sel:
+            ok_h = [abs(L["hs_error"]) <= BUOY_HS_TOL for L in sel]
+            ok_d = [abs(L["dir_error_deg"]) <= BUOY_DIR_TOL_DEG for L in sel]
+            summary[key] = {"legs": len(sel), "hs_within_15pct": int(sum(ok_h)), "dir_within_15deg": int(sum(ok_d)),
+                            "side_right": int(sum(L["side_right"] for L in sel)),
+                            "both": int(sum(a and b for a, b in zip(ok_h, ok_d))),
+                            "max_abs_dir_error_deg": float(max(abs(L["dir_error_deg"]) for L in sel))}
+    return {"legs": legs, "summary": summary}
 
 
 def directional_spectrum(comp: np.ndarray, n_dir: int = 36, n_omega: int = 30, omega_max: float = 2.5) -> dict:
