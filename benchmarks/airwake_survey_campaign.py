@@ -58,7 +58,8 @@ def main(n: int):
                      "wall_s": time.perf_counter() - t0})
         print(seed, tr["error"]["summary"], flush=True)
     fr, frs, mean_ok = [], [], []
-    groups = {"mean_airwake": ([], [], []), "airwake_ratio": ([], [], [])}  # covered, half-width, |error|
+    groups = {"mean_airwake": ([], [], []), "mean_airwake_with_sampling": ([], [], []),
+              "airwake_ratio": ([], [], [])}  # covered, half-width, |error|
     for r in rows:
         for e in r.get("runs", []):
             if "residual_fraction_awsm" not in e:
@@ -66,7 +67,9 @@ def main(n: int):
             fr.append(e["residual_fraction_awsm"])
             frs.append(e["residual_fraction_awsm_seed_order"])
             mean_ok.append(all(c["within"] for c in e["mean_change"]))
-            for key, items in (("mean_airwake", e["mean_airwake"]), ("airwake_ratio", [e["airwake_ratio"]])):
+            for key, items in (("mean_airwake", e["mean_airwake"]),
+                               ("mean_airwake_with_sampling", e["mean_airwake_with_sampling"]),
+                               ("airwake_ratio", [e["airwake_ratio"]])):
                 for c in items:
                     groups[key][0].append(bool(c["covered"]))
                     groups[key][1].append(c["half_width95"])

@@ -21,7 +21,9 @@ Per recording (one mast position, EXECUTE → FINEX; seed 003 §4):
    ship-carried vertical axes — the seed's order; and, as the alternative that has no U·θ term, the
    rotate-first form (:func:`vtrials.reduce.airwake.wind_relative_to_mean_motion`).
 3. Means per component (uncorrected in body axes and in vertical axes, corrected) with
-   autocorrelation-corrected standard errors (:func:`vtrials.reduce.runstats.channel_stats`); the
+   autocorrelation-corrected standard errors (:func:`vtrials.reduce.runstats.channel_stats`) — the
+   uncertainty of the long-run mean in this wind — and the corrected mean over the recording with the
+   instrument's uncertainty alone (``mean_awsm_recording``, :func:`_stats3`); the
    airwake ratio K = mean horizontal speed at the mast / at the reference anemometer (both corrected)
    with its standard error by the delta method on the paired series s_mast − K s_ref (which carries
    their correlation), and the direction offset (mean direction at the mast − at the reference).
@@ -58,13 +60,18 @@ def _interp(t_out, t, x, angular=False):
     return np.interp(t_out, t, x)
 
 
-def _stats3(t, x, inst: dict | None = None) -> list:
+def _stats3(t, x, inst: dict | None = None, sampling: bool = True) -> list:
     """Mean per component with its autocorrelation-corrected standard error; with ``inst`` (the
-    anemometer's stated accuracy: zero offset σ_b, scale σ_s, head alignment σ_a [rad]) the instrument's
-    own uncertainty of a mean is added in quadrature, u² = σ_b² + (σ_s x̄_k)² + σ_a² (|x̄|² − x̄_k²) (the
-    head's misalignment, three small angles of σ_a, turns the mean vector: δ × x̄ moves component k by
-    the other two components), degrees of freedom by Welch–Satterthwaite (the stated accuracies as
-    exact: infinite dof)."""
+    anemometer's stated accuracy: zero offset σ_b, scale σ_s, head alignment σ_a [rad], white noise σ_n
+    per sample) the instrument's own uncertainty of a mean is added in quadrature,
+    u² = σ_b² + (σ_s x̄_k)² + σ_a² (|x̄|² − x̄_k²) (the head's misalignment, three small angles of σ_a,
+    turns the mean vector: δ × x̄ moves component k by the other two components), degrees of freedom by
+    Welch–Satterthwaite (the stated accuracies as exact: infinite dof).
+
+    ``sampling`` False: the uncertainty of the mean OVER THE RECORDING (what the air did while the
+    mast stood there), not of the long-run mean: the gusts' and waves' sampling error, which the
+    autocorrelation-corrected standard error measures, is not an error of that mean; what is left is
+    the instrument's u² plus its white noise averaged, σ_n²/n."""
     out = []
     xm = np.mean(x, axis=0)
     mag2 = float(xm @ xm)
@@ -72,8 +79,12 @@ def _stats3(t, x, inst: dict | None = None) -> list:
         e = channel_stats(t, x[:, k]).estimate()
         if inst:
             ui2 = inst["bias"] ** 2 + (inst["scale"] * e.value) ** 2 + inst["align"] ** 2 * (mag2 - float(xm[k]) ** 2)
-            std = math.sqrt(e.std ** 2 + ui2)
-            dof = e.dof * (std / e.std) ** 4 if e.std > 0 else None
+            if sampling:
+                std = math.sqrt(e.std ** 2 + ui2)
+                dof = e.dof * (std / e.std) ** 4 if e.std > 0 else None
+            else:
+                std = math.sqrt(ui2 + inst.get("noise", 0.0) ** 2 / max(len(t), 1))
+                dof = None
             e = Estimate(e.value, std, dof)
         out.append(e.to_dict())
     return out
@@ -81,7 +92,8 @@ def _stats3(t, x, inst: dict | None = None) -> list:
 
 def _inst(meta: dict) -> dict:
     return {"bias": float(meta.get("bias_std", 0.0) or 0.0), "scale": float(meta.get("scale_sd", 0.0) or 0.0),
-            "align": float(meta.get("misalignment_sd_rad", 0.0) or 0.0)}
+            "align": float(meta.get("misalignment_sd_rad", 0.0) or 0.0),
+            "noise": float(meta.get("noise_std", 0.0) or 0.0)}
 
 
 def _ship_velocity(rec, names: dict, t: np.ndarray, pad_s: float):
@@ -215,7 +227,8 @@ def reduce_airwake_survey(rec, pad_s: float = PAD_S, keep_series: bool = True) -
              "relative_wind_speed_ordered": r["maneuver"]["relative_wind_speed"],
              "t_execute": r["t_execute"], "t_finex": r["t_finex"], "n": int(t.size),
              "mean_measured_body": _stats3(t, m_b, im), "mean_measured_vertical": _stats3(t, m_v, im),
-             "mean_awsm": _stats3(t, corr, im), "mean_awsm_seed_order": _stats3(t, seed, im),
+             "mean_awsm": _stats3(t, corr, im), "mean_awsm_recording": _stats3(t, corr, im, sampling=False),
+             "mean_awsm_seed_order": _stats3(t, seed, im),
              "mean_rotate_first": _stats3(t, first, im),
              "rms_correction": np.std(corr - m_v, axis=0).tolist(),
              "std_measured": np.std(m_v, axis=0).tolist(), "std_awsm": np.std(corr, axis=0).tolist()}
