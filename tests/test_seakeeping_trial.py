@@ -239,3 +239,25 @@ def test_short_trial_wave_fusion_scored(short_trial):
     report = (out / "report.md").read_text()
     assert "Wave fusion (seed 004)" in report
     assert (out / "seakeeping_fusion.png").stat().st_size > 10_000
+
+
+def test_wave_estimates_left_out_with_a_note(short_trial, monkeypatch):
+    """Without the team's design model for the ship, or on legs too short for two Welch segments, the
+    seakeeping reduction gives no ship-as-buoy (or fusion) result and says why in its notes."""
+    from vtrials.records.netcdf import open_record
+    from vtrials.reduce.seakeeping import BUOY_MIN_LEG_S, _by_kind, ship_buoy_block, wave_fusion_block
+    _, _, out = short_trial
+    rec = open_record(out / "records" / "seakeeping.nc")
+    kinds = _by_kind(rec)
+    rec.team = dict(rec.team, ship="no_such_ship")
+    notes = []
+    assert ship_buoy_block(rec, kinds, notes) is None and wave_fusion_block(rec, kinds, notes) is None
+    assert len(notes) == 2 and all("no design-stage RAO model for 'no_such_ship'" in n for n in notes)
+    rec = open_record(out / "records" / "seakeeping.nc")
+    notes = []
+    runs = rec.run_log
+    for run in runs:                                   # a log sheet whose legs were short
+        run["t_finex"] = run["t_execute"] + 0.5 * BUOY_MIN_LEG_S
+    monkeypatch.setattr(type(rec), "run_log", property(lambda self: runs))
+    assert ship_buoy_block(rec, kinds, notes) is None
+    assert "shorter than 256 s" in notes[0]
