@@ -247,9 +247,10 @@ def _motion_roles(rec: Record, kinds: dict, notes: list, what: str):
 
 
 def wave_fusion_block(rec: Record, kinds: dict, notes: list) -> dict | None:
-    """Seed 004's wave fusion per accepted leg (a leg the radar has no spectrum in is left out, noted) (:func:`vtrials.reduce.wavefusion.fuse_run`: the wave radar's
-    H_s scaled by measured over predicted motion RMS through the team's design-stage RAOs) for
-    :data:`FUSION_COMBOS`, or None (with a note when a radar is aboard but the rest is missing)."""
+    """Seed 004's wave fusion per accepted leg for :data:`FUSION_COMBOS`
+    (:func:`vtrials.reduce.wavefusion.fuse_run`: the wave radar's H_s scaled by measured over predicted
+    motion RMS through the team's design-stage RAOs); a leg the radar has no spectrum in is left out with
+    a note. None without a radar, or (with a note) when the rest is missing."""
     from vtrials.reduce.wavefusion import fuse_run
     radars = kinds.get("wave_radar") or []
     if not radars:
