@@ -214,8 +214,10 @@ def reduce_seakeeping(rec: Record) -> dict:
         for run in sorted([r for r in rec.run_log if r["accepted"]], key=lambda r: r["run"]):
             legs.append(reduce_leg(rec, run, kinds))
     out = {"kind": "seakeeping", "legs": legs, "notes": notes, "coherence_min": COHERENCE_MIN}
-    out["ship_buoy"] = ship_buoy_block(rec, kinds, notes)
-    out["wave_fusion"] = wave_fusion_block(rec, kinds, notes)
+    # the wave estimates share the instrument roles and the team's design model (read once)
+    roles = _motion_roles(rec, kinds, notes, "wave estimates (ship as a buoy, fusion)")
+    out["ship_buoy"] = ship_buoy_block(rec, kinds, notes, roles) if roles else None
+    out["wave_fusion"] = wave_fusion_block(rec, kinds, notes, roles) if roles else None
     return out
 
 
@@ -246,16 +248,17 @@ def _motion_roles(rec: Record, kinds: dict, notes: list, what: str):
     return {k: kinds[v][0] for k, v in need.items()}, design, runs
 
 
-def wave_fusion_block(rec: Record, kinds: dict, notes: list) -> dict | None:
+def wave_fusion_block(rec: Record, kinds: dict, notes: list, roles=None) -> dict | None:
     """Seed 004's wave fusion per accepted leg for :data:`FUSION_COMBOS`
     (:func:`vtrials.reduce.wavefusion.fuse_run`: the wave radar's H_s scaled by measured over predicted
     motion RMS through the team's design-stage RAOs); a leg the radar has no spectrum in is left out with
-    a note. None without a radar, or (with a note) when the rest is missing."""
+    a note. None without a radar, or (with a note) when the rest is missing. ``roles``: what
+    :func:`_motion_roles` gave, if the caller has it."""
     from vtrials.reduce.wavefusion import fuse_run
     radars = kinds.get("wave_radar") or []
     if not radars:
         return None
-    got = _motion_roles(rec, kinds, notes, "wave fusion")
+    got = roles or _motion_roles(rec, kinds, notes, "wave fusion")
     if got is None:
         return None
     names, design, runs = got
@@ -279,13 +282,13 @@ def wave_fusion_block(rec: Record, kinds: dict, notes: list) -> dict | None:
             "combos": ["+".join(c) for c in FUSION_COMBOS], "legs": legs}
 
 
-def ship_buoy_block(rec: Record, kinds: dict, notes: list) -> dict | None:
+def ship_buoy_block(rec: Record, kinds: dict, notes: list, roles=None) -> dict | None:
     """The ship as a wave buoy over the trial's accepted legs (:func:`vtrials.reduce.shipbuoy.ship_buoy_from_legs`:
     one sea fitted to all legs' heave, roll and pitch with the team's design-stage RAOs, models/<ship>/design),
     or None with a note when the record lacks the motion sensors, the log or the compass, or the team has no
-    design model for the ship."""
+    design model for the ship. ``roles``: what :func:`_motion_roles` gave, if the caller has it."""
     from vtrials.reduce.shipbuoy import ship_buoy_from_legs
-    got = _motion_roles(rec, kinds, notes, "ship-as-buoy estimate")
+    got = roles or _motion_roles(rec, kinds, notes, "ship-as-buoy estimate")
     if got is None:
         return None
     names, design, runs = got
